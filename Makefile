@@ -1,0 +1,49 @@
+# Basalt's entry points. Every target installs what it needs first (scripts/setup.sh, a no-op
+# when all packages are present), so each works on a fresh Debian 12 machine.
+#
+#   make run        build and play the default show (RUN_ARGS to change it)
+#   make test       build and run every test tier this machine can run, with a summary
+#   make bench      build and run the benchmarks, printing their figures
+#   make lint       clang-format and clang-tidy, as CI checks them
+#   make sanitize   build with AddressSanitizer + UBSan and run the unit, contract and render tiers
+
+BUILD ?= build
+BUILD_TYPE ?= RelWithDebInfo
+RUN_ARGS ?= --seconds 10
+CMAKE_ARGS ?=
+
+.PHONY: all setup configure build run test bench lint sanitize clean
+
+all: build
+
+setup:
+	@scripts/setup.sh
+
+configure: setup
+	@cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DBASALT_WERROR=ON $(CMAKE_ARGS) >/dev/null
+
+build: configure
+	@cmake --build $(BUILD)
+
+run: build
+	$(BUILD)/basalt run $(RUN_ARGS)
+
+test: build
+	@scripts/run-tests.sh $(BUILD)
+
+bench: build
+	@for b in $(BUILD)/tests/bench/basalt_*_bench; do echo "== $$b"; $$b || exit 1; done
+
+lint: configure
+	@scripts/lint.sh $(BUILD)
+
+sanitize: setup
+	@cmake -S . -B $(BUILD)-sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DBASALT_WERROR=ON \
+	  -DBASALT_SANITIZE=address,undefined $(CMAKE_ARGS) >/dev/null
+	@cmake --build $(BUILD)-sanitize
+	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  scripts/run-tests.sh $(BUILD)-sanitize -L 'unit|contract|render|script|fuzz'
+
+clean:
+	rm -rf $(BUILD) $(BUILD)-sanitize out

@@ -1,0 +1,67 @@
+#include "kiosk/frame_loop.h"
+
+#include <chrono>
+
+#include "runtime/log.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Kiosk, "kiosk");
+
+FrameLoop::FrameLoop(const FrameLoopConfig& config, const Clock& clock, ManualClock* manual, runtime::EventLoop& loop,
+                     runtime::Show& show, render::Output& output, render::Renderer& renderer)
+    : config_(config), clock_(clock), manual_(manual), loop_(loop), show_(show), output_(output), renderer_(renderer) {}
+
+void FrameLoop::applyInput(Nanos until) {
+  if (!events_) return;
+  events_->drainWhile([until](const Event& e) { return e.time <= until; },
+                      [this](Event e) {
+                        if (bindings_) bindings_->apply(e, show_);
+                      });
+}
+
+Result<void> FrameLoop::renderFrame(std::int64_t frame, bool last) {
+  if (auto r = output_.beginFrame(); !r) return r;
+  const render::Size size = output_.size();
+  const float aspect = static_cast<float>(size.width) / static_cast<float>(size.height);
+  renderer_.draw(show_, runtime::computeView(show_, aspect), size);
+  if (hook_) {
+    if (auto r = hook_(frame, last, output_); !r) return r;
+  }
+  return output_.present();
+}
+
+Result<FrameLoopStats> FrameLoop::run() {
+  FrameLoopStats stats;
+  const SystemClock wall;
+  const Nanos wallStart = wall.now();
+  const Nanos start = clock_.now();
+  for (std::int64_t frame = 0; config_.maxFrames < 0 || frame < config_.maxFrames; ++frame) {
+    const Nanos due = start + frameTime(frame, config_.fps);
+    if (manual_) {
+      manual_->set(due);
+      // Signals and wake-ups still get through; the manual clock never waits.
+      if (auto r = loop_.dispatch(Nanos{0}); !r) return std::unexpected(r.error());
+    } else {
+      // Sleep in the event loop until the frame is due, serving fds and signals meanwhile.
+      while (!stopRequested_) {
+        const Nanos now = clock_.now();
+        if (now >= due) break;
+        if (auto r = loop_.dispatch(due - now); !r) return std::unexpected(r.error());
+      }
+      if (clock_.now() - due > frameTime(1, config_.fps)) ++stats.lateFrames;
+    }
+    const bool last = stopRequested_ || (config_.maxFrames >= 0 && frame + 1 == config_.maxFrames);
+    applyInput(due);
+    if (auto r = renderFrame(frame, last); !r) return std::unexpected(r.error());
+    if (frame == 0) stats.firstFrameSeconds = toSeconds(wall.now() - wallStart);
+    stats.frames = frame + 1;
+    stats.showTime = due - start;
+    show_.advanceFrame();
+    if (last) break;
+  }
+  stats.wallSeconds = toSeconds(wall.now() - wallStart);
+  return stats;
+}
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,79 @@
+#pragma once
+
+/// \file
+/// \brief The frame loop (DESIGN.md §2): one thread owns EGL and GL; each frame takes its time
+/// from the Clock, applies the input due by then, draws every view and presents.
+
+#include <cstdint>
+#include <functional>
+
+#include "render/output.h"
+#include "render/renderer.h"
+#include "runtime/bindings.h"
+#include "runtime/bounded_queue.h"
+#include "runtime/clock.h"
+#include "runtime/event.h"
+#include "runtime/event_loop.h"
+#include "runtime/show/show.h"
+
+namespace basalt::kiosk {
+
+struct FrameLoopConfig {
+  double fps = 60;
+  std::int64_t maxFrames = -1;  ///< stop after this many frames; -1 runs until stopped
+};
+
+/// \brief What a run did, for the summary line and the status server.
+struct FrameLoopStats {
+  std::int64_t frames = 0;
+  std::int64_t lateFrames = 0;   ///< frames that started after their due time (paced runs)
+  Nanos showTime{0};             ///< Clock time from the first frame to the last
+  double wallSeconds = 0;        ///< real time the loop ran
+  double firstFrameSeconds = 0;  ///< real time from loop start to the first frame presented
+};
+
+/// \brief Runs frames until the frame budget is spent or stop is requested.
+///
+/// Threading: everything runs on the calling thread. Devices feed `events` from their threads
+/// and wake `loop`; the loop never waits on a device.
+class FrameLoop {
+ public:
+  /// \brief Called after a frame is drawn and before it is presented: snapshots, recording,
+  /// tests. `last` is true for the final frame of the run.
+  using FrameHook = std::function<Result<void>(std::int64_t frame, bool last, render::Output& output)>;
+
+  /// With a manual clock (`manual` non-null) each frame advances it by exactly 1/fps and the
+  /// loop never sleeps; otherwise frames are paced on `clock`.
+  FrameLoop(const FrameLoopConfig& config, const Clock& clock, ManualClock* manual, runtime::EventLoop& loop,
+            runtime::Show& show, render::Output& output, render::Renderer& renderer);
+
+  void setFrameHook(FrameHook hook) { hook_ = std::move(hook); }
+  /// \brief The queue input events arrive in (owned by the caller).
+  void setEvents(BoundedQueue<Event>* events, const runtime::Bindings* bindings) {
+    events_ = events;
+    bindings_ = bindings;
+  }
+
+  /// \brief Runs until done; the error is the first failure of drawing, presenting or a hook.
+  Result<FrameLoopStats> run();
+  /// \brief Asks the loop to finish the next frame and return (safe from loop callbacks).
+  void requestStop() { stopRequested_ = true; }
+
+ private:
+  void applyInput(Nanos until);
+  Result<void> renderFrame(std::int64_t frame, bool last);
+
+  FrameLoopConfig config_;
+  const Clock& clock_;
+  ManualClock* manual_;
+  runtime::EventLoop& loop_;
+  runtime::Show& show_;
+  render::Output& output_;
+  render::Renderer& renderer_;
+  FrameHook hook_;
+  BoundedQueue<Event>* events_ = nullptr;
+  const runtime::Bindings* bindings_ = nullptr;
+  bool stopRequested_ = false;
+};
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,190 @@
+// Image files: PNG snapshots through libpng, everything else through OpenImageIO.
+//
+// Serves: snapshots (the default PNG, and any format OIIO writes, chosen by the extension) and
+// image textures. OIIO lives in a module loaded on first use (oiio_module.h says why); PNG
+// writing, on the start-up path of every headless run, needs only libpng.
+// Configuration: BASALT_MODULE_DIR names the folder of the OIIO module (ENV_VARS.md).
+
+#include "media/image_io.h"
+
+#include <dlfcn.h>
+#include <png.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdlib>
+#include <mutex>
+#include <system_error>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/std.h>
+
+#include "media/oiio_module.h"
+#include "runtime/log.h"
+
+namespace basalt::media {
+
+BASALT_LOG_CATEGORY(Media, "media");
+
+namespace {
+
+constexpr const char* kModuleName = "libbasalt_oiio.so";
+
+std::string lowerExtension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+std::vector<std::filesystem::path> moduleSearchPath() {
+  std::vector<std::filesystem::path> dirs;
+  if (const char* env = std::getenv("BASALT_MODULE_DIR"); env && *env) dirs.emplace_back(env);
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    dirs.push_back(exe.parent_path());
+    dirs.push_back(exe.parent_path() / ".." / "lib" / "basalt");
+  }
+  dirs.emplace_back(BASALT_MODULE_BUILD_DIR);
+  return dirs;
+}
+
+struct OiioModule {
+  std::once_flag once;
+  const BasaltOiioApi* api = nullptr;
+  std::string error;
+};
+
+OiioModule& oiioModule() {
+  static OiioModule module;
+  return module;
+}
+
+Result<const BasaltOiioApi*> oiio() {
+  OiioModule& m = oiioModule();
+  std::call_once(m.once, [&m] {
+    std::string tried;
+    for (const auto& dir : moduleSearchPath()) {
+      const std::filesystem::path candidate = dir / kModuleName;
+      std::error_code ec;
+      if (!std::filesystem::exists(candidate, ec)) {
+        tried += fmt::format(" {}", candidate);
+        continue;
+      }
+      void* handle = ::dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!handle) {
+        m.error = fmt::format("cannot load {}: {}", candidate, ::dlerror());
+        return;
+      }
+      auto entry = reinterpret_cast<BasaltOiioApiFn>(::dlsym(handle, "basalt_oiio_api"));
+      const BasaltOiioApi* api = entry ? entry() : nullptr;
+      if (!api || api->version != kBasaltOiioApiVersion) {
+        m.error = fmt::format("{} is not a matching Basalt OIIO module; rebuild Basalt", candidate);
+        return;
+      }
+      log::debug(kLogMedia, "loaded the OpenImageIO module from {}", candidate);
+      m.api = api;
+      return;
+    }
+    m.error = fmt::format(
+        "the OpenImageIO module {} is not installed (looked for{}); rebuild Basalt or set "
+        "BASALT_MODULE_DIR",
+        kModuleName, tried);
+  });
+  if (!m.api) return fail(Errc::kUnavailable, m.error);
+  return m.api;
+}
+
+/// Writes to a temporary name in the target's folder (so the rename is atomic), then renames.
+template <typename WriteFn>
+Result<void> writeAtomically(const std::filesystem::path& path, WriteFn&& write) {
+  const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (ec) {
+    return fail(Errc::kIo, fmt::format("cannot create folder {}: {}; choose a writable folder", folder, ec.message()),
+                path.string());
+  }
+  // The temporary keeps the extension, since writers choose the format by it.
+  const std::filesystem::path temporary =
+      folder / fmt::format(".{}.{}.partial{}", path.stem().string(), ::getpid(), path.extension().string());
+  if (auto r = write(temporary); !r) {
+    std::filesystem::remove(temporary, ec);
+    return std::unexpected(r.error().at(path.string()));
+  }
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    return fail(Errc::kIo, fmt::format("cannot move the image into place: {}", ec.message()), path.string());
+  }
+  return {};
+}
+
+Result<void> writePng(const std::filesystem::path& path, const Image& image) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = image.width;
+  png.height = image.height;
+  switch (image.channels) {
+    case 1: png.format = PNG_FORMAT_GRAY; break;
+    case 2: png.format = PNG_FORMAT_GA; break;
+    case 3: png.format = PNG_FORMAT_RGB; break;
+    default: png.format = PNG_FORMAT_RGBA; break;
+  }
+  if (!png_image_write_to_file(&png, path.c_str(), 0, image.pixels.data(), static_cast<png_int_32>(image.rowBytes()),
+                               nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return fail(Errc::kIo, fmt::format("cannot write the PNG: {}", message));
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<void> writeImage(const std::filesystem::path& path, const Image& image) {
+  if (image.empty() || image.channels < 1 || image.channels > 4 || image.pixels.size() < image.byteSize()) {
+    return fail(Errc::kInvalidArgument, "the image to write is empty or malformed", path.string());
+  }
+  if (lowerExtension(path) == ".png" && image.type == ChannelType::kU8) {
+    return writeAtomically(path, [&](const std::filesystem::path& tmp) { return writePng(tmp, image); });
+  }
+  auto api = oiio();
+  if (!api) return std::unexpected(api.error().at(path.string()));
+  return writeAtomically(path, [&](const std::filesystem::path& tmp) -> Result<void> {
+    std::array<char, 512> error{};
+    if ((*api)->write(tmp.c_str(), image.pixels.data(), image.width, image.height, image.channels,
+                      static_cast<std::uint32_t>(channelBytes(image.type)), error.data(), error.size()) != 0) {
+      return fail(Errc::kIo, fmt::format("cannot write the image: {}; use .png, .jpg, .tif or .exr", error.data()));
+    }
+    return {};
+  });
+}
+
+Result<Image> readImage(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return fail(Errc::kNotFound, "no such image file", path.string());
+  }
+  auto api = oiio();
+  if (!api) return std::unexpected(api.error().at(path.string()));
+  Image image;
+  BasaltOiioImage out{};
+  out.context = &image;
+  out.allocate = [](void* context, std::uint32_t w, std::uint32_t h, std::uint32_t c, std::uint32_t bytes) {
+    auto* img = static_cast<Image*>(context);
+    *img = Image::make(w, h, c, bytes == 2 ? ChannelType::kU16 : ChannelType::kU8);
+    return img->pixels.data();
+  };
+  std::array<char, 512> error{};
+  if ((*api)->read(path.c_str(), &out, error.data(), error.size()) != 0) {
+    return fail(Errc::kParse, fmt::format("cannot read the image: {}", error.data()), path.string());
+  }
+  return image;
+}
+
+}  // namespace basalt::media

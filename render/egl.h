@@ -1,0 +1,76 @@
+#pragma once
+
+/// \file
+/// \brief Owners of EGL handles: a display (terminated when the last owner goes) and a context
+/// that keeps its display alive (Magnum's rule: GL objects never outlive what they need).
+
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "runtime/error.h"
+
+namespace basalt::render {
+
+/// \brief An initialised EGLDisplay. Shared: contexts and surfaces hold a reference.
+class EglDisplay {
+ public:
+  /// \brief Mesa's surfaceless platform: rendering with no display server and no DRM master.
+  static Result<std::shared_ptr<EglDisplay>> openSurfaceless();
+  /// \brief A display on a native platform (GBM device, Wayland or X11 display).
+  static Result<std::shared_ptr<EglDisplay>> openPlatform(EGLenum platform, void* nativeDisplay, std::string_view what);
+  ~EglDisplay();
+  EglDisplay(const EglDisplay&) = delete;
+  EglDisplay& operator=(const EglDisplay&) = delete;
+
+  [[nodiscard]] EGLDisplay handle() const { return display_; }
+  [[nodiscard]] bool hasExtension(std::string_view name) const;
+  [[nodiscard]] const std::string& vendor() const { return vendor_; }
+  [[nodiscard]] int major() const { return major_; }
+  [[nodiscard]] int minor() const { return minor_; }
+
+ private:
+  struct Token {};
+
+ public:
+  EglDisplay(Token, EGLDisplay display, int major, int minor);
+
+ private:
+  EGLDisplay display_;
+  int major_;
+  int minor_;
+  std::string extensions_;
+  std::string vendor_;
+};
+
+/// \brief An OpenGL ES 3 context. Keeps its display alive; destroyed on the thread that owns it.
+class EglContext {
+ public:
+  /// \brief Creates an ES 3.x context (3.2 where offered, 3.0 at least). `config` may be
+  /// EGL_NO_CONFIG_KHR for a surfaceless context.
+  static Result<std::unique_ptr<EglContext>> create(std::shared_ptr<EglDisplay> display, EGLConfig config);
+  ~EglContext();
+  EglContext(const EglContext&) = delete;
+  EglContext& operator=(const EglContext&) = delete;
+
+  /// \brief Makes the context current on this thread with `surface` (or none).
+  [[nodiscard]] Result<void> makeCurrent(EGLSurface surface = EGL_NO_SURFACE) const;
+  [[nodiscard]] EGLContext handle() const { return context_; }
+  [[nodiscard]] const std::shared_ptr<EglDisplay>& display() const { return display_; }
+
+ private:
+  EglContext(std::shared_ptr<EglDisplay> display, EGLContext context);
+  std::shared_ptr<EglDisplay> display_;
+  EGLContext context_;
+};
+
+/// \brief True when the space-separated extension list `all` names `name` exactly (EGL and GL).
+bool extensionListHas(std::string_view all, std::string_view name);
+
+/// \brief "EGL_BAD_ALLOC" and friends, for messages.
+std::string_view eglErrorName(EGLint error);
+
+}  // namespace basalt::render

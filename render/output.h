@@ -1,0 +1,62 @@
+#pragma once
+
+/// \file
+/// \brief Where frames go: the Output interface and the headless output. KMS and window
+/// outputs implement the same interface (DESIGN.md §3).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "runtime/error.h"
+#include "runtime/image.h"
+
+namespace basalt::render {
+
+struct Size {
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  friend bool operator==(const Size&, const Size&) = default;
+};
+
+/// \brief A place frames are drawn into and presented: an offscreen framebuffer, a KMS
+/// connector or a window. The output owns the EGL display and context the renderer draws with.
+///
+/// Threading: created, used and destroyed on the frame loop's thread, which holds the context.
+class Output {
+ public:
+  virtual ~Output() = default;
+
+  /// \brief "headless", "kms" or "window".
+  [[nodiscard]] virtual std::string_view kind() const = 0;
+  [[nodiscard]] virtual Size size() const = 0;
+  /// \brief One line for people: kind, size, renderer, connector or window.
+  [[nodiscard]] virtual std::string describe() const = 0;
+
+  /// \brief Binds the framebuffer the next frame is drawn into and sets the viewport.
+  [[nodiscard]] virtual Result<void> beginFrame() = 0;
+  /// \brief Shows what was drawn since beginFrame(): a swap, a page flip, or nothing.
+  [[nodiscard]] virtual Result<void> present() = 0;
+  /// \brief Copies the frame drawn since beginFrame() into `out` as RGBA8, top row first.
+  /// Call before present(). Reuses `out`'s storage when its shape already fits.
+  [[nodiscard]] virtual Result<void> readBack(Image& out);
+  /// \brief A descriptor that becomes readable when the output is ready for the next frame
+  /// (a DRM page-flip event), or -1 when presenting does not pace the loop.
+  [[nodiscard]] virtual int paceFd() const { return -1; }
+  /// \brief Handles readiness of paceFd() (reads the DRM event).
+  virtual void onPaceReady() {}
+};
+
+/// \brief Renders into an offscreen framebuffer on EGL's surfaceless platform (Mesa): no
+/// display, no DRM master, no window system. What tests, CI, recording and headless nodes use.
+class HeadlessOutput;
+
+/// \brief Opens a headless output of `size`. Fails with a message saying what to install when
+/// EGL or OpenGL ES 3 is missing.
+Result<std::unique_ptr<Output>> createHeadlessOutput(Size size);
+
+/// \brief Reads the bound read framebuffer's `size` into `out` as RGBA8, top row first.
+Result<void> readFramebuffer(Size size, Image& out);
+
+}  // namespace basalt::render

@@ -1,0 +1,275 @@
+#include "runtime/show/show.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace basalt::runtime {
+
+Show::Show() = default;
+
+NodeId Show::addNode(SceneNode node) {
+  node.partIds.clear();
+  if (node.mesh) {
+    node.partIds.reserve(node.mesh->parts.size());
+    for (const MeshPart& mp : node.mesh->parts) node.partIds.push_back(internPart(mp.name));
+  }
+  if (node.parent >= static_cast<std::int32_t>(nodes_.size())) node.parent = -1;
+  nodes_.push_back(std::move(node));
+  return static_cast<NodeId>(nodes_.size() - 1);
+}
+
+void Show::setNodeTransform(NodeId id, const Mat4& local) {
+  if (id < nodes_.size()) nodes_[id].local = local;
+}
+
+Mat4 Show::worldTransform(NodeId id) const {
+  Mat4 m = nodes_[id].local;
+  for (std::int32_t p = nodes_[id].parent; p >= 0; p = nodes_[static_cast<std::size_t>(p)].parent) {
+    m = nodes_[static_cast<std::size_t>(p)].local * m;
+  }
+  return m;
+}
+
+void Show::clear() {
+  nodes_.clear();
+  parts_.clear();
+  resolved_.clear();
+  resolvedAt_.clear();
+  resetAttributes();
+}
+
+Bounds Show::sceneBounds() const {
+  Bounds b;
+  for (NodeId i = 0; i < nodes_.size(); ++i) {
+    const SceneNode& n = nodes_[i];
+    if (!n.mesh || n.mesh->positions.empty()) continue;
+    const Bounds mb = n.mesh->bounds();
+    const Mat4 w = worldTransform(i);
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 c{(corner & 1) ? mb.max.x : mb.min.x, (corner & 2) ? mb.max.y : mb.min.y,
+                   (corner & 4) ? mb.max.z : mb.min.z};
+      b.add(w.transformPoint(c));
+    }
+  }
+  return b;
+}
+
+PartId Show::internPart(const std::string& name) {
+  if (auto existing = findPart(name)) return *existing;
+  PartState state;
+  state.name = name;
+  parts_.push_back(std::move(state));
+  resolved_.emplace_back();
+  resolvedAt_.push_back(0);
+  return static_cast<PartId>(parts_.size() - 1);
+}
+
+std::optional<PartId> Show::findPart(std::string_view name) const {
+  for (PartId i = 0; i < parts_.size(); ++i) {
+    if (parts_[i].name == name) return i;
+  }
+  return std::nullopt;
+}
+
+void Show::setPartSelected(PartId id, bool selected) { parts_[id].selected = selected; }
+
+void Show::selectAll(bool selected) {
+  for (PartState& p : parts_) p.selected = selected;
+}
+
+void Show::setPartTexture(PartId id, std::string texture) { parts_[id].texture = std::move(texture); }
+
+void Show::clearPartAttr(PartId id, AttrId attr) {
+  parts_[id].mask.reset(static_cast<std::size_t>(attr));
+  ++styleRevision_;
+}
+
+const PartStyle& Show::resolvedStyle(PartId id) const {
+  if (resolvedAt_[id] != styleRevision_) {
+    resolved_[id] = resolveStyle(global_, parts_[id].own, parts_[id].mask);
+    resolvedAt_[id] = styleRevision_;
+  }
+  return resolved_[id];
+}
+
+void Show::resetAttributes() {
+  global_ = PartStyle{};
+  for (PartState& p : parts_) {
+    p.own = PartStyle{};
+    p.mask.reset();
+    p.selected = true;
+    p.texture.clear();
+  }
+  ++styleRevision_;
+  lights_ = defaultLights();
+  depthCue_ = {};
+  fog_ = {};
+  texture_ = {};
+  clipping_ = {};
+  annotation_ = {};
+  picking_ = {};
+  globalSettings_ = {};
+  motion_ = {};
+  position_ = {};
+  view_ = {};
+  environment_ = {};
+  backgroundKind_ = BackgroundKind::kColor;
+  backgroundImage_.clear();
+  earthSky_ = {};
+}
+
+namespace {
+Mat4 rotationXYZ(const Vec3& d) {
+  // X first, then Y, then Z: the column-vector product applies the rightmost first.
+  return Mat4::rotationZ(d.z) * Mat4::rotationY(d.y) * Mat4::rotationX(d.x);
+}
+}  // namespace
+
+void Show::rotateGlobal(const Vec3& degrees) { position_.global = rotationXYZ(degrees) * position_.global; }
+void Show::rotateLocal(const Vec3& degrees) { position_.local = position_.local * rotationXYZ(degrees); }
+void Show::translateGlobal(const Vec3& offset) { position_.global = Mat4::translation(offset) * position_.global; }
+void Show::translateLocal(const Vec3& offset) { position_.local = position_.local * Mat4::translation(offset); }
+void Show::scaleGlobal(float factor) { position_.global = Mat4::scaling({factor, factor, factor}) * position_.global; }
+void Show::scaleLocal(float factor) { position_.local = position_.local * Mat4::scaling({factor, factor, factor}); }
+
+void Show::resetTransforms() {
+  position_.global = Mat4{};
+  position_.local = Mat4{};
+}
+
+void Show::startMotion() {
+  motion_.globalFreeRun = true;
+  motion_.localFreeRun = true;
+  motion_.framesLeft = motion_.numFrames > 0 ? motion_.numFrames : -1;
+}
+
+void Show::stopMotion() {
+  motion_.globalFreeRun = false;
+  motion_.localFreeRun = false;
+  motion_.framesLeft = -1;
+}
+
+void Show::advanceFrame() {
+  if (motion_.globalFreeRun) {
+    rotateGlobal(motion_.globalRotate);
+    if (motion_.globalScale != 1.0f) scaleGlobal(motion_.globalScale);
+  }
+  if (motion_.localFreeRun) {
+    rotateLocal(motion_.localRotate);
+    if (motion_.localScale != 1.0f) scaleLocal(motion_.localScale);
+  }
+  if (motion_.framesLeft > 0) {
+    --motion_.framesLeft;
+    if (motion_.framesLeft == 0) stopMotion();
+  }
+  ++frameNumber_;
+}
+
+ViewTransforms computeView(const Show& show, float aspect) {
+  const ViewSettings& v = show.view();
+  const Bounds b = show.sceneBounds();
+
+  // Normalisation: centre the scene and scale it into window units.
+  Vec3 center = b.empty ? Vec3{} : b.center();
+  switch (v.objectCenter) {
+    case ObjectCenter::kUseSlider: center = v.center; break;
+    case ObjectCenter::kPlusX: center.x = b.max.x; break;
+    case ObjectCenter::kMinusX: center.x = b.min.x; break;
+    case ObjectCenter::kPlusY: center.y = b.max.y; break;
+    case ObjectCenter::kMinusY: center.y = b.min.y; break;
+    case ObjectCenter::kPlusZ: center.z = b.max.z; break;
+    case ObjectCenter::kMinusZ: center.z = b.min.z; break;
+    case ObjectCenter::kNone: break;
+  }
+  const float radius = b.empty ? 1.0f : std::max(b.radius(), 1e-6f);
+  float scale = 1.0f;
+  switch (v.objectScale) {
+    case ObjectScale::kFullScreen: scale = 1.0f / radius; break;
+    case ObjectScale::kHalfScreen: scale = 0.5f / radius; break;
+    case ObjectScale::kOriginal: scale = 1.0f; break;
+  }
+  const Mat4 normalise = Mat4::scaling({scale, scale, scale}) * Mat4::translation(-center);
+
+  ViewTransforms t;
+  t.model = show.position().global * show.position().local * normalise;
+
+  // Window bounds -1..1 at the narrower dimension, shrunk or grown by the view scale.
+  const float viewScale = v.viewScale > 0 ? v.viewScale : 1.0f;
+  float halfW = aspect >= 1 ? aspect : 1.0f;
+  float halfH = aspect >= 1 ? 1.0f : 1.0f / aspect;
+  halfW /= viewScale;
+  halfH /= viewScale;
+  const float zClip = std::max(v.zClipScale, 1e-3f);
+  if (v.perspective > 0) {
+    const float d = v.perspective;
+    t.eye = {0, 0, d};
+    t.view = Mat4::translation({0, 0, -d});
+    const float n = std::max(d - zClip, d * 1e-3f);
+    const float f = d + zClip;
+    t.projection = Mat4::frustum(-halfW * n / d, halfW * n / d, -halfH * n / d, halfH * n / d, n, f);
+  } else {
+    const float d = zClip + 1.0f;
+    t.eye = {0, 0, d};
+    t.view = Mat4::translation({0, 0, -d});
+    t.projection = Mat4::orthographic(-halfW, halfW, -halfH, halfH, d - zClip, d + zClip);
+  }
+  return t;
+}
+
+std::shared_ptr<const Mesh> makeColorCube() {
+  auto mesh = std::make_shared<Mesh>();
+  struct Face {
+    const char* name;
+    Vec3 normal, u, v;
+  };
+  // Parts follow LAVA's demo script naming ("face 3", "face 6").
+  const Face faces[6] = {
+      {"face 1", {0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {"face 2", {0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
+      {"face 3", {1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {"face 4", {-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
+      {"face 5", {0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, {"face 6", {0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
+  };
+  for (const Face& f : faces) {
+    const auto base = static_cast<std::uint32_t>(mesh->positions.size());
+    const Vec2 uv[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    const float su[4] = {-1, 1, 1, -1}, sv[4] = {-1, -1, 1, 1};
+    for (int i = 0; i < 4; ++i) {
+      mesh->positions.push_back(f.normal + f.u * su[i] + f.v * sv[i]);
+      mesh->normals.push_back(f.normal);
+      mesh->texcoords.push_back(uv[i]);
+    }
+    MeshPart part;
+    part.name = f.name;
+    part.firstTriangleIndex = static_cast<std::uint32_t>(mesh->triangles.size());
+    for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) mesh->triangles.push_back(base + i);
+    part.triangleIndexCount = 6;
+    part.firstEdgeIndex = static_cast<std::uint32_t>(mesh->edges.size());
+    for (std::uint32_t i : {0u, 1u, 1u, 2u, 2u, 3u, 3u, 0u}) mesh->edges.push_back(base + i);
+    part.edgeIndexCount = 8;
+    part.facetCount = 1;
+    mesh->parts.push_back(std::move(part));
+  }
+  return mesh;
+}
+
+Show Show::makeDefault() {
+  Show show;
+  SceneNode node;
+  node.name = "cube";
+  node.mesh = makeColorCube();
+  show.addNode(std::move(node));
+  // One colour per face, set as `obj_colors.part_color` does: surface, line and marker colour.
+  const Color3 colours[6] = {{1, 0, 0}, {0, 1, 1}, {0, 1, 0}, {1, 0, 1}, {0, 0, 1}, {1, 1, 0}};
+  for (PartId id = 0; id < show.partCount(); ++id) {
+    const Color3 c = colours[id % 6];
+    show.editPartStyle(id, AttrId::kFrontColor, [&](PartStyle& s) { s.front.color = c; });
+    show.editPartStyle(id, AttrId::kLinesColor, [&](PartStyle& s) { s.lines.color = c; });
+    show.editPartStyle(id, AttrId::kMarkersColor, [&](PartStyle& s) { s.markers.color = c; });
+  }
+  // Start turned so that three faces show, then turn slowly about X and Y.
+  show.rotateGlobal({25, -35, 0});
+  show.motion().globalRotate = {0.25f, 0.5f, 0};
+  show.motion().globalFreeRun = true;
+  return show;
+}
+
+}  // namespace basalt::runtime

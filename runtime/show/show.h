@@ -1,0 +1,218 @@
+#pragma once
+
+/// \file
+/// \brief The Show: the scene state that scripts, bindings and the control server change and
+/// the renderer draws. LAVA's object with its named parts and attributes, its lights, view,
+/// motion and environment, and the thesis' scene graph of placed, parented, instanced meshes.
+///
+/// Threading: a Show belongs to the frame loop's thread. Devices and media never touch it;
+/// they push events and frames that the loop applies.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "runtime/math.h"
+#include "runtime/show/attributes.h"
+#include "runtime/show/mesh.h"
+
+namespace basalt::runtime {
+
+using PartId = std::uint32_t;
+using NodeId = std::uint32_t;
+
+/// \brief One placed mesh (or a pure transform) in the scene graph.
+struct SceneNode {
+  std::string name;
+  std::int32_t parent = -1;          ///< index of the parent node; parents come first
+  Mat4 local;                        ///< relative to the parent
+  std::shared_ptr<const Mesh> mesh;  ///< null for grouping nodes; shared by instances
+  std::vector<PartId> partIds;       ///< the Show part of each mesh part, same order
+  bool visible = true;
+};
+
+/// \brief A part as LAVA's "Part Selection" and per-part attributes see it.
+struct PartState {
+  std::string name;      ///< case-sensitive, may contain spaces
+  bool selected = true;  ///< displayed
+  PartStyle own;         ///< this part's settings where `mask` has the bit
+  AttrMask mask;         ///< attributes set for this part (override global)
+  std::string texture;   ///< texture source name ("" = none): file or stream
+};
+
+/// \brief LAVA's performance meter (§9), filled by the frame loop from the renderer's counts.
+struct PerformanceMeter {
+  std::uint64_t triangles = 0;
+  std::uint64_t lines = 0;
+  std::uint64_t points = 0;
+  std::uint64_t parts = 0;
+  std::uint64_t facets = 0;
+  double framesPerSecond = 0;
+  double primitivesPerSecond = 0;
+  double samplePeriodSeconds = 2.0;  ///< "The default value is 2 seconds"
+};
+
+class Show {
+ public:
+  /// \brief An empty show with every attribute at LAVA's default.
+  Show();
+
+  /// \brief LAVA's start-up scene: the colour cube on black under the default lights, turning
+  /// slowly (global free run).
+  static Show makeDefault();
+
+  // ---- Scene graph ----
+  [[nodiscard]] const std::vector<SceneNode>& nodes() const { return nodes_; }
+  /// \brief Adds a node; its mesh parts become Show parts (parts with the same name are shared,
+  /// so instances and repeated names are addressed together). Parents must be added first.
+  NodeId addNode(SceneNode node);
+  void setNodeTransform(NodeId id, const Mat4& local);
+  /// \brief The node's transform composed with all its parents'.
+  [[nodiscard]] Mat4 worldTransform(NodeId id) const;
+  /// \brief Removes all nodes and parts and resets every attribute: LAVA's "all attributes get
+  /// reset whenever a new object is loaded".
+  void clear();
+  /// \brief Bounds of every node's mesh in scene coordinates (at the nodes' current placement).
+  [[nodiscard]] Bounds sceneBounds() const;
+
+  // ---- Parts ----
+  [[nodiscard]] std::size_t partCount() const { return parts_.size(); }
+  [[nodiscard]] std::optional<PartId> findPart(std::string_view name) const;
+  [[nodiscard]] const PartState& part(PartId id) const { return parts_[id]; }
+  void setPartSelected(PartId id, bool selected);
+  void selectAll(bool selected);
+  void setPartTexture(PartId id, std::string texture);
+
+  // ---- Attributes ----
+  [[nodiscard]] const PartStyle& globalStyle() const { return global_; }
+  /// \brief Changes the global style. Parts that set an attribute themselves keep their value.
+  template <typename Edit>
+  void editGlobalStyle(Edit&& edit) {
+    edit(global_);
+    ++styleRevision_;
+  }
+  /// \brief Changes attribute `attr` of one part through `edit`, which receives the part's
+  /// current resolved style, and marks the attribute as the part's own.
+  template <typename Edit>
+  void editPartStyle(PartId id, AttrId attr, Edit&& edit) {
+    PartStyle style = resolvedStyle(id);
+    edit(style);
+    copyAttr(attr, style, parts_[id].own);
+    parts_[id].mask.set(static_cast<std::size_t>(attr));
+    ++styleRevision_;
+  }
+  /// \brief Makes the part follow the global value of `attr` again.
+  void clearPartAttr(PartId id, AttrId attr);
+  /// \brief The style a part is drawn with: global, overridden by the part's own settings.
+  /// Cached; never allocates once every part has been resolved.
+  [[nodiscard]] const PartStyle& resolvedStyle(PartId id) const;
+  /// \brief Bumped by every style change (renderers and Save Model compare it).
+  [[nodiscard]] std::uint64_t styleRevision() const { return styleRevision_; }
+
+  std::array<Light, kMaxLights>& lights() { return lights_; }
+  [[nodiscard]] const std::array<Light, kMaxLights>& lights() const { return lights_; }
+  DepthCue& depthCue() { return depthCue_; }
+  [[nodiscard]] const DepthCue& depthCue() const { return depthCue_; }
+  Fog& fog() { return fog_; }
+  [[nodiscard]] const Fog& fog() const { return fog_; }
+  TextureSettings& texture() { return texture_; }
+  [[nodiscard]] const TextureSettings& texture() const { return texture_; }
+  ModelClipping& modelClipping() { return clipping_; }
+  [[nodiscard]] const ModelClipping& modelClipping() const { return clipping_; }
+  Annotation& annotation() { return annotation_; }
+  [[nodiscard]] const Annotation& annotation() const { return annotation_; }
+  Picking& picking() { return picking_; }
+  [[nodiscard]] const Picking& picking() const { return picking_; }
+  GlobalSettings& global() { return globalSettings_; }
+  [[nodiscard]] const GlobalSettings& global() const { return globalSettings_; }
+  Motion& motion() { return motion_; }
+  [[nodiscard]] const Motion& motion() const { return motion_; }
+  ViewSettings& view() { return view_; }
+  [[nodiscard]] const ViewSettings& view() const { return view_; }
+  Environment& environment() { return environment_; }
+  [[nodiscard]] const Environment& environment() const { return environment_; }
+  BackgroundKind& backgroundKind() { return backgroundKind_; }
+  [[nodiscard]] BackgroundKind backgroundKind() const { return backgroundKind_; }
+  std::string& backgroundImage() { return backgroundImage_; }
+  [[nodiscard]] const std::string& backgroundImage() const { return backgroundImage_; }
+  EarthSky& earthSky() { return earthSky_; }
+  [[nodiscard]] const EarthSky& earthSky() const { return earthSky_; }
+  PerformanceMeter& performance() { return performance_; }
+  [[nodiscard]] const PerformanceMeter& performance() const { return performance_; }
+
+  /// \brief Resets the global settings (LAVA `global.reset_attr`): background, deferral,
+  /// buffering and stereo. Per-part attributes are untouched, as in LAVA.
+  void resetGlobalSettings() { globalSettings_ = GlobalSettings{}; }
+  /// \brief Everything back to LAVA's defaults, keeping the scene (and part names).
+  void resetAttributes();
+
+  // ---- Placement and motion ----
+  [[nodiscard]] const Position& position() const { return position_; }
+  Position& position() { return position_; }
+  /// \brief Rotates the global matrix about the world axes, X then Y then Z, in degrees.
+  void rotateGlobal(const Vec3& degrees);
+  /// \brief Rotates the local matrix about the object's own axes, X then Y then Z.
+  void rotateLocal(const Vec3& degrees);
+  void translateGlobal(const Vec3& offset);
+  void translateLocal(const Vec3& offset);
+  void scaleGlobal(float factor);
+  void scaleLocal(float factor);
+  /// \brief Global and local matrices back to identity (motion keeps running).
+  void resetTransforms();
+  /// \brief Starts motion for `motion().numFrames` frames (0: until stopped).
+  void startMotion();
+  void stopMotion();
+  /// \brief Advances one frame: applies free-run motion and counts the frame.
+  void advanceFrame();
+  [[nodiscard]] std::uint64_t frameNumber() const { return frameNumber_; }
+
+ private:
+  PartId internPart(const std::string& name);
+
+  std::vector<SceneNode> nodes_;
+  std::vector<PartState> parts_;
+  PartStyle global_;
+  mutable std::vector<PartStyle> resolved_;        // cache, one per part
+  mutable std::vector<std::uint64_t> resolvedAt_;  // styleRevision_ each cache entry was made at
+  std::uint64_t styleRevision_ = 1;
+
+  std::array<Light, kMaxLights> lights_ = defaultLights();
+  DepthCue depthCue_;
+  Fog fog_;
+  TextureSettings texture_;
+  ModelClipping clipping_;
+  Annotation annotation_;
+  Picking picking_;
+  GlobalSettings globalSettings_;
+  Motion motion_;
+  Position position_;
+  ViewSettings view_;
+  Environment environment_;
+  BackgroundKind backgroundKind_ = BackgroundKind::kColor;
+  std::string backgroundImage_;
+  EarthSky earthSky_;
+  PerformanceMeter performance_;
+  std::uint64_t frameNumber_ = 0;
+};
+
+/// \brief The transforms one plain view of the Show needs.
+struct ViewTransforms {
+  Mat4 model;       ///< object coordinates to world: global * local * normalisation
+  Mat4 view;        ///< world to eye
+  Mat4 projection;  ///< eye to clip
+  Vec3 eye;         ///< eye position in world coordinates
+};
+
+/// \brief LAVA's view (§6.1 "View"): the scene centred and scaled into window bounds -1..1 at the
+/// narrower dimension, seen from `view().perspective` units away on +Z (orthographic at 0).
+ViewTransforms computeView(const Show& show, float aspect);
+
+/// \brief The colour cube LAVA starts with: six faces, parts "face 1" to "face 6", each with
+/// its own colour, unit half-size, outward normals.
+std::shared_ptr<const Mesh> makeColorCube();
+
+}  // namespace basalt::runtime

@@ -1,0 +1,40 @@
+// SyntheticDial: a dial box with no hardware behind it.
+//
+// Serves demos and tests: plays a list of scripted turns and presses on the injected Clock.
+// Limits: 8 dials and 32 buttons, like LAVA's box; events are only produced from service().
+
+#include "sim/synthetic_dial.h"
+
+namespace basalt::sim {
+
+SyntheticDial::SyntheticDial(std::vector<ScriptedInput> script, const Clock& clock, bool loop)
+    : DialBox(devices::DeviceInfo{"Synthetic dial box", "synthetic", "virtual", 0, 0, "synthetic:dial", ""}, 8, 32),
+      script_(std::move(script)),
+      clock_(clock),
+      loop_(loop) {}
+
+Result<void> SyntheticDial::doOpen() {
+  next_ = 0;
+  origin_ = clock_.now();
+  return {};
+}
+
+void SyntheticDial::doClose() { next_ = script_.size(); }
+
+void SyntheticDial::doService(Nanos now) {
+  while (!script_.empty()) {
+    if (next_ >= script_.size()) {
+      if (!loop_) return;
+      // Start the next lap after the last event's time.
+      origin_ += script_.back().time + Nanos{1};
+      next_ = 0;
+    }
+    const ScriptedInput& in = script_[next_];
+    const Nanos due = origin_ + in.time;
+    if (due > now) return;
+    emit(Event{due, 0, in.kind, in.index, in.value});
+    ++next_;
+  }
+}
+
+}  // namespace basalt::sim

@@ -1,0 +1,53 @@
+#pragma once
+
+/// \file
+/// \brief Runs a program as a child process for tests: captures its output, signals it, and
+/// never waits forever.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace basalt::test {
+
+struct ProcessResult {
+  int exitCode = -1;      ///< exit status, or 128 + signal when killed
+  bool timedOut = false;  ///< killed by the time limit
+  std::string output;     ///< stdout and stderr, interleaved as written
+};
+
+/// \brief A running child with stdout and stderr on one pipe.
+class Process {
+ public:
+  /// \brief Starts `argv[0]` (a path) with `argv`, the current environment plus `env`.
+  static Process start(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env = {});
+  Process(Process&& other) noexcept;
+  Process& operator=(Process&&) = delete;
+  Process(const Process&) = delete;
+  ~Process();
+
+  [[nodiscard]] pid_t pid() const { return pid_; }
+  [[nodiscard]] bool started() const { return pid_ > 0; }
+  void signal(int sig) const;
+  /// \brief Reads output until the child exits or `limit` passes (then SIGKILL).
+  ProcessResult wait(std::chrono::milliseconds limit = std::chrono::seconds(60));
+  /// \brief Reads what output is available within `limit`; for waiting on a line.
+  bool waitForOutput(const std::string& needle, std::chrono::milliseconds limit);
+  [[nodiscard]] const std::string& outputSoFar() const { return output_; }
+
+ private:
+  Process(pid_t pid, int fd) : pid_(pid), fd_(fd) {}
+  bool readSome(int timeoutMs);
+  pid_t pid_ = -1;
+  int fd_ = -1;
+  std::string output_;
+};
+
+/// \brief Starts, waits and returns the result.
+ProcessResult run(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env = {},
+                  std::chrono::milliseconds limit = std::chrono::seconds(60));
+
+}  // namespace basalt::test
