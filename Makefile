@@ -34,7 +34,7 @@ test: build
 bench: build
 	@for b in $(BUILD)/tests/bench/basalt_*_bench; do echo "== $$b"; $$b || exit 1; done
 
-lint: configure
+lint: build
 	@scripts/lint.sh $(BUILD)
 
 sanitize: setup

@@ -53,6 +53,7 @@ struct RenderOptions {
   bool faceDistinguishing = false;              // "Default is Off"
   RasterOp rasterOp = RasterOp::kCopy;          // "Default is Copy"
   bool hiddenSurfaceRemoval = true;             // HLHSR "Default is on"
+  friend bool operator==(const RenderOptions&, const RenderOptions&) = default;
 };
 
 enum class MarkerType : std::uint8_t { kDot, kPlus, kAsterisk, kCircle, kCross, kSquare, kBowtieNE, kBowtieNW };
@@ -63,6 +64,7 @@ struct MarkerAttributes {
   Antialiasing antialiasing = Antialiasing::kOff;
   float scaleFactor = 10.0f;  // "Default is 10.0"
   ColorSelector colorSelector = ColorSelector::kContext;
+  friend bool operator==(const MarkerAttributes&, const MarkerAttributes&) = default;
 };
 
 enum class EndpointStyle : std::uint8_t { kButt, kSquare, kRound };
@@ -91,6 +93,7 @@ struct LineAttributes {
   Color3 altColor{1, 1, 1};                            // "The default is white"
   ColorSelector colorSelector = ColorSelector::kContext;
   bool colorInterpolation = false;  // "Default is OFF"
+  friend bool operator==(const LineAttributes&, const LineAttributes&) = default;
 };
 
 enum class FillStyle : std::uint8_t { kSolid, kHollow, kEmpty, kOpaqueStipple, kStipple, kPattern };
@@ -132,6 +135,7 @@ struct SurfaceAttributes {
   TransparencyMethod transparencyMethod = TransparencyMethod::kNone;  // "None ... default"
   TransparencyBlend transparencyBlend = TransparencyBlend::kNone;     // "None ... (default)"
   float transparency = 0.0f;                                          // 0 opaque .. 1 fully transparent
+  friend bool operator==(const SurfaceAttributes&, const SurfaceAttributes&) = default;
 };
 
 /// \brief `edges.show_edges`: the script accepts off/on; the menu also offers XGL and software.
@@ -147,6 +151,7 @@ struct EdgeAttributes {
   Color3 altColor{1, 1, 1};                    // "Default is white"
   bool silhouette = false;                     // "Default is OFF"
   float softwareOffset = 0.1f;                 // "The default value is 0.1"
+  friend bool operator==(const EdgeAttributes&, const EdgeAttributes&) = default;
 };
 
 enum class NurbsApproxMethod : std::uint8_t {
@@ -174,6 +179,7 @@ struct NurbsAttributes {
   std::int32_t isoCurvesU = 1;  // Basalt default (manual silent)
   std::int32_t isoCurvesV = 1;
   NurbsTessellation tessellation = NurbsTessellation::kDynamic;  // "Default is <Dynamic>"
+  friend bool operator==(const NurbsAttributes&, const NurbsAttributes&) = default;
 };
 
 /// \brief Every attribute that may be set per part. Trivially copyable: resolution copies the
