@@ -5,6 +5,7 @@
 #   make test       build and run every test tier this machine can run, with a summary
 #   make bench      build and run the benchmarks, printing their figures
 #   make lint       clang-format and clang-tidy, as CI checks them
+#   make format     reformat the sources with clang-format
 #   make sanitize   build with AddressSanitizer + UBSan and run the unit, contract and render tiers
 
 BUILD ?= build
@@ -12,7 +13,7 @@ BUILD_TYPE ?= RelWithDebInfo
 RUN_ARGS ?= --seconds 10
 CMAKE_ARGS ?=
 
-.PHONY: all setup configure build run test bench lint sanitize clean
+.PHONY: all setup configure build run test bench lint format sanitize clean
 
 all: build
 
@@ -36,6 +37,10 @@ bench: build
 
 lint: build
 	@scripts/lint.sh $(BUILD)
+
+format:
+	@git ls-files -co --exclude-standard -- '*.cpp' '*.h' | grep -E '^(runtime|devices|media|render|kiosk|sim|tests)/' | \
+	  xargs clang-format-19 -i
 
 sanitize: setup
 	@cmake -S . -B $(BUILD)-sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DBASALT_WERROR=ON \

@@ -50,9 +50,10 @@ void pinDriverLibraries() {
     dl_iterate_phdr(
         [](dl_phdr_info* info, std::size_t, void*) {
           const std::string_view path = info->dlpi_name ? info->dlpi_name : "";
-          const bool driver = path.find("/dri/") != std::string_view::npos || path.find("libEGL_") != std::string_view::npos ||
-                              path.find("libLLVM") != std::string_view::npos || path.find("libgallium") != std::string_view::npos ||
-                              path.find("libglapi") != std::string_view::npos;
+          const bool driver =
+              path.find("/dri/") != std::string_view::npos || path.find("libEGL_") != std::string_view::npos ||
+              path.find("libLLVM") != std::string_view::npos || path.find("libgallium") != std::string_view::npos ||
+              path.find("libglapi") != std::string_view::npos;
           if (driver) ::dlopen(info->dlpi_name, RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE);
           return 0;
         },
