@@ -10,13 +10,13 @@ namespace {
 /// Prints the usual table and remembers each median in seconds.
 class MedianReporter : public benchmark::ConsoleReporter {
  public:
-  explicit MedianReporter(Medians& medians) : medians_(medians) {}
+  explicit MedianReporter(Medians& medians) : ConsoleReporter(OO_Tabular), medians_(medians) {}
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
       if (run.aggregate_name != "median") continue;
       const double perIteration = run.GetAdjustedRealTime();  // in run.time_unit
-      medians_[run.run_name.str()] = perIteration * benchmark::GetTimeUnitMultiplier(run.time_unit);
+      medians_[run.run_name.function_name] = perIteration / benchmark::GetTimeUnitMultiplier(run.time_unit);
     }
   }
 

@@ -11,8 +11,7 @@
 
 namespace basalt::bench {
 
-/// \brief Medians by benchmark name (without the "_median" suffix), in the benchmark's time
-/// unit converted to seconds.
+/// \brief Median time per iteration in seconds, by benchmark function name.
 using Medians = std::map<std::string, double>;
 
 /// \brief Runs the benchmarks, then calls `summarise` with the medians.

@@ -70,8 +70,8 @@ BENCHMARK(firstFrameWritten)->UseManualTime()->Unit(benchmark::kMillisecond)->It
 
 int main(int argc, char** argv) {
   return basalt::bench::runBenchmarks(argc, argv, [](const basalt::bench::Medians& m) {
-    const auto floor = m.find("processStartFloor_median");
-    const auto first = m.find("firstFrameWritten_median");
+    const auto floor = m.find("processStartFloor");
+    const auto first = m.find("firstFrameWritten");
     if (floor == m.end() || first == m.end()) {
       std::printf("startup: no figures (a benchmark failed)\n");
       return;
