@@ -52,7 +52,10 @@ int writeImage(const char* path, const void* pixels, std::uint32_t width, std::u
 }
 
 int readImage(const char* path, BasaltOiioImage* out, char* error, std::size_t errorSize) {
-  OIIO::ImageBuf source(path);
+  // Alpha as stored (unassociated): OIIO would otherwise premultiply PNG and TGA colours.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  OIIO::ImageBuf source(path, 0, 0, nullptr, &config);
   if (!source.init_spec(path, 0, 0)) {
     setError(error, errorSize, source.geterror());
     return 1;
