@@ -12,7 +12,9 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "kiosk/commands.h"
 #include "kiosk/frame_loop.h"
+#include "kiosk/options.h"
 #include "media/image_io.h"
 #include "render/output.h"
 #include "render/renderer.h"
@@ -49,7 +51,113 @@ Result<void> checkWritableFolder(const std::filesystem::path& file) {
   return {};
 }
 
+constexpr std::uint32_t kMaxDimension = 16384;
+
+Result<void> parseSize(std::string_view text, RunOptions& run) {
+  const auto x = text.find_first_of("xX");
+  const auto bad = [&] {
+    return fail(
+        Errc::kInvalidArgument,
+        fmt::format("--size needs WIDTHxHEIGHT between 1 and {} each, e.g. 1280x720, not '{}'", kMaxDimension, text));
+  };
+  if (x == std::string_view::npos) return bad();
+  auto w = integerOption("--size", text.substr(0, x), 1, kMaxDimension);
+  auto h = integerOption("--size", text.substr(x + 1), 1, kMaxDimension);
+  if (!w || !h) return bad();
+  run.width = static_cast<std::uint32_t>(*w);
+  run.height = static_cast<std::uint32_t>(*h);
+  return {};
+}
+
 }  // namespace
+
+std::string_view runUsage() {
+  return R"(Usage: basalt run [options]
+
+Plays a show. With no show given it plays the default show: LAVA's start-up scene, a
+coloured cube on black, 500x500, turning slowly under LAVA's default lights. With no display
+it renders offscreen through EGL (headless) and writes a snapshot of the last frame.
+Without --frames or --seconds it runs until interrupted (Ctrl-C, SIGTERM) and exits cleanly.
+
+Options:
+  --frames N         stop after N frames
+  --seconds S        stop after S seconds of show time
+  --size WxH         output size in pixels (default 500x500)
+  --headless         render offscreen even when a display is available
+  --snapshot PATH    write the last frame to PATH (format from the extension: .png, .jpg,
+                     .tif, .exr, ...); default: OUTPUT_DIR/snapshot.png
+  --output-dir DIR   folder for snapshots (default: out)
+  --fps F            show frame rate (default 60)
+  --realtime         pace frames on the system clock at the frame rate
+  --fast             step a manual clock exactly 1/fps per frame and render as fast as
+                     possible (the default headless when --frames or --seconds is given)
+  -h, --help         this text
+
+Exit status: 0 when the show ran, 1 when it could not start or failed, 2 for usage errors.
+)";
+}
+
+Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
+  auto parsed = parseOptions("run", args,
+                             {{"--help|-h"},
+                              {"--frames", true},
+                              {"--seconds", true},
+                              {"--size", true},
+                              {"--headless"},
+                              {"--snapshot", true},
+                              {"--output-dir", true},
+                              {"--fps", true},
+                              {"--realtime"},
+                              {"--fast"}});
+  if (!parsed) return std::unexpected(parsed.error());
+  RunOptions run;
+  for (const ParsedOption& o : *parsed) {
+    if (o.name.empty()) {
+      return fail(Errc::kInvalidArgument,
+                  fmt::format("unexpected argument '{}' for 'basalt run'; see 'basalt run --help'", o.value));
+    }
+    if (o.name == "--help") {
+      run.help = true;
+    } else if (o.name == "--frames") {
+      auto n = integerOption(o.name, o.value, 1, INT64_MAX);
+      if (!n) return std::unexpected(n.error());
+      run.frames = *n;
+    } else if (o.name == "--seconds") {
+      auto v = numberOption(o.name, o.value, 1e-6, 1e9);
+      if (!v) return std::unexpected(v.error());
+      run.seconds = *v;
+    } else if (o.name == "--size") {
+      if (auto r = parseSize(o.value, run); !r) return std::unexpected(r.error());
+    } else if (o.name == "--headless") {
+      run.headless = true;
+    } else if (o.name == "--snapshot") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--snapshot needs a file name");
+      run.snapshot = std::filesystem::path(o.value);
+    } else if (o.name == "--output-dir") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--output-dir needs a folder");
+      run.outputDir = std::filesystem::path(o.value);
+    } else if (o.name == "--fps") {
+      auto v = numberOption(o.name, o.value, 1, 1000);
+      if (!v) return std::unexpected(v.error());
+      run.fps = *v;
+    } else if (o.name == "--realtime") {
+      run.clock = ClockMode::kSystem;
+    } else if (o.name == "--fast") {
+      run.clock = ClockMode::kManual;
+    }
+  }
+  return run;
+}
+
+int runMain(std::span<const std::string_view> args) {
+  auto options = parseRunOptions(args);
+  if (!options) return usageError(options.error().describe());
+  if (options->help) {
+    fmt::print("{}", runUsage());
+    return 0;
+  }
+  return runShow(*options);
+}
 
 int runShow(const RunOptions& options) {
   const std::filesystem::path snapshotPath = options.snapshot ? *options.snapshot : options.outputDir / "snapshot.png";

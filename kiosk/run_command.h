@@ -1,14 +1,47 @@
 #pragma once
 
 /// \file
-/// \brief `basalt run`: wires the show, the output, the renderer and the frame loop.
+/// \brief `basalt run`: plays a show; wires the show, the output, the renderer and the frame loop.
 
-#include "kiosk/cli.h"
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string_view>
+
+#include "runtime/error.h"
 
 namespace basalt::kiosk {
 
-/// \brief Plays a show as the options say; returns the process exit status (0, or 1 with a
-/// message on stderr that says what failed and what to do).
+/// \brief Which clock drives a run: the system clock paces frames in real time; the manual
+/// clock advances exactly 1/fps per frame and renders as fast as the machine goes.
+enum class ClockMode : std::uint8_t { kAuto, kSystem, kManual };
+
+/// \brief Options of `basalt run`.
+struct RunOptions {
+  bool help = false;                   ///< --help was given
+  std::optional<std::int64_t> frames;  ///< stop after this many frames
+  std::optional<double> seconds;       ///< stop after this much show time
+  std::uint32_t width = 500;           ///< LAVA's start-up window is 500 x 500
+  std::uint32_t height = 500;
+  bool headless = false;                          ///< force the offscreen output
+  std::optional<std::filesystem::path> snapshot;  ///< where the last frame goes
+  std::filesystem::path outputDir = "out";        ///< default folder for snapshots
+  double fps = 60;
+  ClockMode clock = ClockMode::kAuto;
+};
+
+/// \brief Parses the arguments after `run`.
+[[nodiscard]] Result<RunOptions> parseRunOptions(std::span<const std::string_view> args);
+
+/// \brief The text of `basalt run --help`.
+std::string_view runUsage();
+
+/// \brief `basalt run ...`: parses, then plays; returns the exit status.
+int runMain(std::span<const std::string_view> args);
+
+/// \brief Plays a show as the options say; returns 0, or 1 with a message on stderr that says
+/// what failed and what to do.
 int runShow(const RunOptions& options);
 
 }  // namespace basalt::kiosk

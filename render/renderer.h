@@ -9,6 +9,7 @@
 
 #include "render/gl.h"
 #include "render/output.h"
+#include "render/texture_registry.h"
 #include "runtime/error.h"
 #include "runtime/show/show.h"
 
@@ -41,6 +42,8 @@ class Renderer {
   /// seen through `view`, into a viewport of `viewport` pixels.
   void draw(const runtime::Show& show, const runtime::ViewTransforms& view, Size viewport);
   [[nodiscard]] const DrawCounts& lastCounts() const { return counts_; }
+  /// \brief The textures parts can name (image files and streams).
+  TextureRegistry& textures() { return textures_; }
 
  private:
   struct GpuMesh;
@@ -60,6 +63,7 @@ class Renderer {
   std::unordered_map<std::uint64_t, std::unique_ptr<GpuMesh>> meshes_;
   std::uint64_t framesSinceSweep_ = 0;
   DrawCounts counts_;
+  TextureRegistry textures_;
 };
 
 }  // namespace basalt::render

@@ -5,47 +5,48 @@
 
 #include <vector>
 
-#include "kiosk/cli.h"
+#include "kiosk/commands.h"
+#include "kiosk/options.h"
+#include "kiosk/run_command.h"
 
 namespace basalt::kiosk {
 namespace {
 
-Result<Command> parse(std::vector<std::string_view> args) { return parseCommandLine(args); }
+Result<RunOptions> parse(std::vector<std::string_view> args) { return parseRunOptions(args); }
 
 TEST(CommandLine, RunOptions) {
-  auto c = parse({"run", "--frames", "30", "--size=1280x720", "--headless", "--snapshot", "x/y.png", "--seconds", "2.5",
+  auto c = parse({"--frames", "30", "--size=1280x720", "--headless", "--snapshot", "x/y.png", "--seconds", "2.5",
                   "--fps=30", "--fast", "--output-dir", "o"});
   ASSERT_TRUE(c) << c.error().describe();
-  EXPECT_EQ(c->kind, Command::Kind::kRun);
-  EXPECT_EQ(c->run.frames, 30);
-  EXPECT_EQ(c->run.width, 1280u);
-  EXPECT_EQ(c->run.height, 720u);
-  EXPECT_TRUE(c->run.headless);
-  EXPECT_EQ(c->run.snapshot, std::filesystem::path("x/y.png"));
-  EXPECT_DOUBLE_EQ(*c->run.seconds, 2.5);
-  EXPECT_DOUBLE_EQ(c->run.fps, 30);
-  EXPECT_EQ(c->run.clock, ClockMode::kManual);
-  EXPECT_EQ(c->run.outputDir, std::filesystem::path("o"));
+  EXPECT_EQ(c->frames, 30);
+  EXPECT_EQ(c->width, 1280u);
+  EXPECT_EQ(c->height, 720u);
+  EXPECT_TRUE(c->headless);
+  EXPECT_EQ(c->snapshot, std::filesystem::path("x/y.png"));
+  EXPECT_DOUBLE_EQ(*c->seconds, 2.5);
+  EXPECT_DOUBLE_EQ(c->fps, 30);
+  EXPECT_EQ(c->clock, ClockMode::kManual);
+  EXPECT_EQ(c->outputDir, std::filesystem::path("o"));
+  EXPECT_FALSE(c->help);
 }
 
 TEST(CommandLine, DefaultsAreLavasWindow) {
-  auto c = parse({"run"});
+  auto c = parse({});
   ASSERT_TRUE(c);
-  EXPECT_EQ(c->run.width, 500u);
-  EXPECT_EQ(c->run.height, 500u);
-  EXPECT_FALSE(c->run.frames);
+  EXPECT_EQ(c->width, 500u);
+  EXPECT_EQ(c->height, 500u);
+  EXPECT_FALSE(c->frames);
 }
 
 TEST(CommandLine, HelpAndVersion) {
-  EXPECT_EQ(parse({})->kind, Command::Kind::kHelp);
-  EXPECT_EQ(parse({"--help"})->kind, Command::Kind::kHelp);
-  auto runHelp = parse({"run", "--help"});
-  ASSERT_TRUE(runHelp);
-  EXPECT_EQ(runHelp->helpTopic, "run");
-  EXPECT_EQ(parse({"--version"})->kind, Command::Kind::kVersion);
+  EXPECT_TRUE(parse({"--help"})->help);
+  EXPECT_TRUE(parse({"-h"})->help);
   for (std::string_view option : {"--frames", "--seconds", "--size", "--headless", "--snapshot"}) {
-    EXPECT_NE(helpText("run").find(option), std::string::npos) << option << " is not in 'basalt run --help'";
+    EXPECT_NE(runUsage().find(option), std::string::npos) << option << " is not in 'basalt run --help'";
   }
+  EXPECT_NE(overviewHelp().find("run"), std::string::npos);
+  const std::vector<std::string_view> version{"--version"};
+  EXPECT_EQ(dispatch(version), 0);
 }
 
 TEST(CommandLine, BadInputSaysWhatIsWrong) {
@@ -54,17 +55,16 @@ TEST(CommandLine, BadInputSaysWhatIsWrong) {
     std::string_view expected;
   };
   const Case cases[] = {
-      {{"run", "--bogus"}, "unknown option '--bogus'"},
-      {{"run", "--frames"}, "--frames needs a value"},
-      {{"run", "--frames", "abc"}, "--frames needs a whole number, not 'abc'"},
-      {{"run", "--frames", "0"}, "--frames must be at least 1"},
-      {{"run", "--seconds", "-1"}, "--seconds must be more than 0"},
-      {{"run", "--size", "640"}, "--size needs WIDTHxHEIGHT"},
-      {{"run", "--size", "0x10"}, "between 1 and"},
-      {{"run", "--fps", "0"}, "--fps must be between 1 and 1000"},
-      {{"run", "extra"}, "unexpected argument 'extra'"},
-      {{"fly"}, "unknown command 'fly'"},
-      {{"--nope"}, "unknown option '--nope'"},
+      {{"--bogus"}, "unknown option '--bogus' for 'basalt run'"},
+      {{"--frames"}, "--frames needs a value"},
+      {{"--frames", "abc"}, "--frames needs a whole number, not 'abc'"},
+      {{"--frames", "0"}, "--frames must be between 1 and"},
+      {{"--seconds", "-1"}, "--seconds must be between"},
+      {{"--size", "640"}, "--size needs WIDTHxHEIGHT"},
+      {{"--size", "0x10"}, "between 1 and 16384"},
+      {{"--fps", "0"}, "--fps must be between 1 and 1000"},
+      {{"--headless=yes"}, "--headless takes no value"},
+      {{"extra"}, "unexpected argument 'extra'"},
   };
   for (const Case& c : cases) {
     auto r = parse(c.args);
@@ -72,6 +72,27 @@ TEST(CommandLine, BadInputSaysWhatIsWrong) {
     EXPECT_NE(r.error().message().find(c.expected), std::string::npos)
         << "got: " << r.error().message() << "\nwanted: " << c.expected;
   }
+}
+
+TEST(CommandLine, UnknownCommandsAndOptionsAreUsageErrors) {
+  const std::vector<std::string_view> fly{"fly"};
+  EXPECT_EQ(dispatch(fly), 2);
+  const std::vector<std::string_view> nope{"--nope"};
+  EXPECT_EQ(dispatch(nope), 2);
+  const std::vector<std::string_view> helpFly{"help", "fly"};
+  EXPECT_EQ(dispatch(helpFly), 2);
+}
+
+TEST(Options, PositionalsFlagsAndValues) {
+  const std::vector<std::string_view> args{"show.toml", "--verbose", "--level=3", "--", "--not-an-option"};
+  auto parsed = parseOptions("check", args, {{"--verbose|-v"}, {"--level", true}});
+  ASSERT_TRUE(parsed) << parsed.error().describe();
+  ASSERT_EQ(parsed->size(), 4u);
+  EXPECT_EQ((*parsed)[0].name, "");
+  EXPECT_EQ((*parsed)[0].value, "show.toml");
+  EXPECT_EQ((*parsed)[1].name, "--verbose");
+  EXPECT_EQ((*parsed)[2].value, "3");
+  EXPECT_EQ((*parsed)[3].value, "--not-an-option");
 }
 
 }  // namespace

@@ -19,7 +19,8 @@ Image gradient(std::uint32_t w, std::uint32_t h, std::uint32_t channels) {
   for (std::uint32_t y = 0; y < h; ++y)
     for (std::uint32_t x = 0; x < w; ++x)
       for (std::uint32_t c = 0; c < channels; ++c)
-        img.pixels[(std::size_t{y} * w + x) * channels + c] = static_cast<std::uint8_t>((x * 7 + y * 3 + c * 50) & 0xff);
+        img.pixels[(std::size_t{y} * w + x) * channels + c] =
+            static_cast<std::uint8_t>((x * 7 + y * 3 + c * 50) & 0xff);
   return img;
 }
 

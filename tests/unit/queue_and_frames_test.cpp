@@ -9,6 +9,7 @@
 
 #include "runtime/bounded_queue.h"
 #include "runtime/frame.h"
+#include "runtime/frame_queue.h"
 
 namespace basalt {
 namespace {
@@ -142,6 +143,61 @@ TEST(FramePool, FramesCrossThreads) {
   }
   EXPECT_EQ(released.load(), 200);
   EXPECT_EQ(pool->available(), 3u);
+}
+
+}  // namespace
+}  // namespace basalt
+
+namespace basalt {
+namespace {
+
+FrameRef frameAt(const std::shared_ptr<FramePool>& pool, std::int64_t ptsMs) {
+  FrameRef f = pool->acquire();
+  f->pts = std::chrono::milliseconds(ptsMs);
+  return f;
+}
+
+TEST(FrameQueue, TakesTheNewestDueFrameAndNeverOneFromTheFuture) {
+  auto pool = FramePool::create({PixelFormat::kGray8, 2, 2, 8});
+  FrameQueue q(8);
+  for (int ms : {0, 33, 66, 100}) ASSERT_TRUE(q.tryPush(frameAt(pool, ms)));
+  EXPECT_FALSE(q.takeDue(std::chrono::milliseconds(-1))) << "nothing is due before the first pts";
+  FrameRef f = q.takeDue(std::chrono::milliseconds(70));
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->pts, std::chrono::milliseconds(66));
+  EXPECT_EQ(q.dropped(), 2u) << "frames 0 and 33 were passed over";
+  EXPECT_EQ(q.size(), 1u);
+  EXPECT_FALSE(q.takeDue(std::chrono::milliseconds(99))) << "frame 100 is still in the future";
+  f.reset();
+  EXPECT_EQ(pool->available(), 7u) << "passed-over frames must go back to their pool";
+}
+
+TEST(FrameQueue, LiveSourcesDropTheOldestWhenFull) {
+  auto pool = FramePool::create({PixelFormat::kGray8, 2, 2, 8});
+  FrameQueue q(2);
+  q.pushDroppingOldest(frameAt(pool, 1));
+  q.pushDroppingOldest(frameAt(pool, 2));
+  q.pushDroppingOldest(frameAt(pool, 3));
+  Nanos front{};
+  ASSERT_TRUE(q.frontPts(front));
+  EXPECT_EQ(front, std::chrono::milliseconds(2));
+  EXPECT_EQ(q.dropped(), 1u);
+  EXPECT_FALSE(q.tryPush(frameAt(pool, 4)));
+}
+
+TEST(FrameQueue, ProducerWaitsForRoomUntilTheConsumerTakes) {
+  auto pool = FramePool::create({PixelFormat::kGray8, 2, 2, 8});
+  FrameQueue q(1);
+  ASSERT_TRUE(q.tryPush(frameAt(pool, 0)));
+  std::atomic<bool> gotRoom{false};
+  std::thread producer([&] { gotRoom = q.waitForRoom(std::chrono::seconds(10)); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(gotRoom.load());
+  EXPECT_TRUE(q.takeDue(std::chrono::milliseconds(5)));
+  producer.join();
+  EXPECT_TRUE(gotRoom.load());
+  q.close();
+  EXPECT_FALSE(q.waitForRoom(std::chrono::seconds(10))) << "a closed queue must not keep producers waiting";
 }
 
 }  // namespace
