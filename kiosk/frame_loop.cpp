@@ -20,15 +20,28 @@ void FrameLoop::applyInput(Nanos until) {
                       });
 }
 
-Result<void> FrameLoop::renderFrame(std::int64_t frame, bool last) {
+Result<void> FrameLoop::renderFrame(const FrameContext& context) {
+  for (FrameParticipant* p : participants_) {
+    if (auto r = p->beforeDraw(context); !r) return r;
+  }
   if (auto r = output_.beginFrame(); !r) return r;
   const render::Size size = output_.size();
   const float aspect = static_cast<float>(size.width) / static_cast<float>(size.height);
   renderer_.draw(show_, runtime::computeView(show_, aspect), size);
+  for (FrameParticipant* p : participants_) {
+    if (auto r = p->afterDraw(context, output_); !r) return r;
+  }
   if (hook_) {
-    if (auto r = hook_(frame, last, output_); !r) return r;
+    if (auto r = hook_(context.frame, context.last, output_); !r) return r;
   }
   return output_.present();
+}
+
+bool FrameLoop::participantWantsStop() const {
+  for (const FrameParticipant* p : participants_) {
+    if (p->wantsStop()) return true;
+  }
+  return false;
 }
 
 Result<FrameLoopStats> FrameLoop::run() {
@@ -51,13 +64,16 @@ Result<FrameLoopStats> FrameLoop::run() {
       }
       if (clock_.now() - due > frameTime(1, config_.fps)) ++stats.lateFrames;
     }
-    const bool last = stopRequested_ || (config_.maxFrames >= 0 && frame + 1 == config_.maxFrames);
+    const bool last =
+        stopRequested_ || participantWantsStop() || (config_.maxFrames >= 0 && frame + 1 == config_.maxFrames);
     applyInput(due);
-    if (auto r = renderFrame(frame, last); !r) return std::unexpected(r.error());
+    const FrameContext context{frame, due, last};
+    if (auto r = renderFrame(context); !r) return std::unexpected(r.error());
     if (frame == 0) stats.firstFrameSeconds = toSeconds(wall.now() - wallStart);
     stats.frames = frame + 1;
     stats.showTime = due - start;
     show_.advanceFrame();
+    for (FrameParticipant* p : participants_) p->afterPresent(context);
     if (last) break;
   }
   stats.wallSeconds = toSeconds(wall.now() - wallStart);

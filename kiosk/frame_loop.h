@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "render/output.h"
 #include "render/renderer.h"
@@ -17,6 +18,40 @@
 #include "runtime/show/show.h"
 
 namespace basalt::kiosk {
+
+/// \brief What a participant learns about the frame being made.
+struct FrameContext {
+  std::int64_t frame = 0;  ///< frame number, from 0
+  Nanos time{0};           ///< the frame's presentation time on the show's Clock
+  bool last = false;       ///< the loop will stop after this frame
+};
+
+/// \brief Something that takes part in every frame: the script interpreter, the device manager,
+/// texture streams, the kiosk controller, the recorder, the status server's metrics.
+///
+/// The loop calls participants in the order they were added, on the frame loop's thread. They
+/// must not block: anything slow runs on its own thread and hands results over through queues.
+class FrameParticipant {
+ public:
+  virtual ~FrameParticipant() = default;
+  /// \brief Step 2-4 of the frame (after input): change the show, pick stream frames.
+  /// Returning an error stops the run with that error.
+  virtual Result<void> beforeDraw(const FrameContext& frame) {
+    (void)frame;
+    return {};
+  }
+  /// \brief After drawing, before presenting: read-back users (snapshots, recording, tests).
+  virtual Result<void> afterDraw(const FrameContext& frame, render::Output& output) {
+    (void)frame;
+    (void)output;
+    return {};
+  }
+  /// \brief After presenting and after the show advanced: metrics, watchdog pings.
+  virtual void afterPresent(const FrameContext& frame) { (void)frame; }
+  /// \brief True when this participant wants the loop to end after the current frame (a
+  /// script's `quit`, the end of a recording).
+  [[nodiscard]] virtual bool wantsStop() const { return false; }
+};
 
 struct FrameLoopConfig {
   double fps = 60;
@@ -48,6 +83,8 @@ class FrameLoop {
             runtime::Show& show, render::Output& output, render::Renderer& renderer);
 
   void setFrameHook(FrameHook hook) { hook_ = std::move(hook); }
+  /// \brief Adds a participant (borrowed: it must outlive the loop's run()).
+  void addParticipant(FrameParticipant& participant) { participants_.push_back(&participant); }
   /// \brief The queue input events arrive in (owned by the caller).
   void setEvents(BoundedQueue<Event>* events, const runtime::Bindings* bindings) {
     events_ = events;
@@ -61,7 +98,8 @@ class FrameLoop {
 
  private:
   void applyInput(Nanos until);
-  Result<void> renderFrame(std::int64_t frame, bool last);
+  Result<void> renderFrame(const FrameContext& context);
+  [[nodiscard]] bool participantWantsStop() const;
 
   FrameLoopConfig config_;
   const Clock& clock_;
@@ -71,6 +109,7 @@ class FrameLoop {
   render::Output& output_;
   render::Renderer& renderer_;
   FrameHook hook_;
+  std::vector<FrameParticipant*> participants_;
   BoundedQueue<Event>* events_ = nullptr;
   const runtime::Bindings* bindings_ = nullptr;
   bool stopRequested_ = false;
