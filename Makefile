@@ -7,13 +7,15 @@
 #   make lint       clang-format and clang-tidy, as CI checks them
 #   make format     reformat the sources with clang-format
 #   make sanitize   build with AddressSanitizer + UBSan and run the unit, contract and render tiers
+#   make fuzz       build the libFuzzer targets with clang-19 and run each for FUZZ_SECONDS
 
 BUILD ?= build
 BUILD_TYPE ?= RelWithDebInfo
 RUN_ARGS ?= --seconds 10
 CMAKE_ARGS ?=
+FUZZ_SECONDS ?= 60
 
-.PHONY: all setup configure build run test bench lint format sanitize clean
+.PHONY: all setup configure build run test bench lint format sanitize fuzz clean
 
 all: build
 
@@ -50,5 +52,8 @@ sanitize: setup
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  scripts/run-tests.sh $(BUILD)-sanitize -L 'unit|contract|render|script|fuzz'
 
+fuzz: setup
+	@scripts/fuzz.sh $(FUZZ_SECONDS)
+
 clean:
-	rm -rf $(BUILD) $(BUILD)-sanitize out
+	rm -rf $(BUILD) $(BUILD)-sanitize build-fuzz out
