@@ -29,9 +29,10 @@ std::vector<std::string_view> words(std::string_view s) {
 
 template <typename T>
 bool parseNumber(std::string_view s, T& out, int base) {
-  const auto* end = s.data() + s.size();
-  auto [ptr, ec] = std::from_chars(s.data(), end, out, base);
-  return ec == std::errc{} && ptr == end;
+  const char* first = s.data();  // NOLINT(bugprone-suspicious-stringview-data-usage): the end goes with it
+  const char* last = first + s.size();
+  auto [ptr, ec] = std::from_chars(first, last, out, base);
+  return ec == std::errc{} && ptr == last;
 }
 
 /// "LEN b0 b1 ..." with LEN decimal and bytes hex; the count must match.

@@ -82,13 +82,11 @@ int main(int argc, char** argv) {
     if (target) {
       if (i + 1 >= argc || !parseDouble(argv[i + 1], *target)) return usage();
       ++i;
-    } else if (!arg.empty() && arg[0] == '-') {
-      return usage();
-    } else if (opt.file.empty()) {
-      opt.file = arg;
-    } else {
-      return usage();
+      continue;
     }
+    const bool isOption = !arg.empty() && arg[0] == '-';
+    if (isOption || !opt.file.empty()) return usage();
+    opt.file = arg;
   }
   if (opt.file.empty() || opt.speed <= 0 || (opt.waitOpen >= 0 && opt.waitSignal >= 0)) return usage();
 
@@ -173,7 +171,16 @@ int main(int argc, char** argv) {
   for (std::size_t i = 0; i < recording->size(); ++i) {
     for (const auto& r : (*recording)[i].reports) items.push_back({r.time, i, &r.bytes});
   }
-  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.time < b.time; });
+  // By time; reports at the same time keep their recorded order (the vector's).
+  std::vector<std::size_t> order(items.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&items](std::size_t a, std::size_t b) {
+    return items[a].time != items[b].time ? items[a].time < items[b].time : a < b;
+  });
+  std::vector<Item> sorted;
+  sorted.reserve(items.size());
+  for (const std::size_t i : order) sorted.push_back(items[i]);
+  items = std::move(sorted);
   const auto start = Clock::now();
   std::chrono::nanoseconds previous{0};
   std::chrono::nanoseconds due{0};

@@ -94,7 +94,7 @@ bool UhidDevice::pump(int timeoutMs) {
       reply.type = UHID_GET_REPORT_REPLY;
       reply.u.get_report_reply.id = ev.u.get_report.id;
       reply.u.get_report_reply.err = EIO;
-      (void)writeEvent(fd_.get(), reply);
+      if (!writeEvent(fd_.get(), reply)) ++failedReplies_;
       break;
     }
     case UHID_SET_REPORT: {
@@ -102,7 +102,7 @@ bool UhidDevice::pump(int timeoutMs) {
       reply.type = UHID_SET_REPORT_REPLY;
       reply.u.set_report_reply.id = ev.u.set_report.id;
       reply.u.set_report_reply.err = EIO;
-      (void)writeEvent(fd_.get(), reply);
+      if (!writeEvent(fd_.get(), reply)) ++failedReplies_;
       break;
     }
     default: break;

@@ -63,6 +63,8 @@ class UhidDevice {
   [[nodiscard]] bool opened() const { return opened_; }
   /// \brief Whether a reader has opened the device at any time since it was made.
   [[nodiscard]] bool everOpened() const { return everOpened_; }
+  /// \brief Replies to the kernel's get/set report requests that could not be written.
+  [[nodiscard]] int failedReplies() const { return failedReplies_; }
   /// \brief Output reports the host sent (LEDs, haptics), oldest first.
   [[nodiscard]] const std::vector<std::vector<std::uint8_t>>& outputs() const { return outputs_; }
 
@@ -76,6 +78,7 @@ class UhidDevice {
   bool started_ = false;
   bool opened_ = false;
   bool everOpened_ = false;
+  int failedReplies_ = 0;
   std::vector<std::vector<std::uint8_t>> outputs_;
 };
 

@@ -419,8 +419,6 @@ def read(path):
 def skip_reason_if_disabled():
     if os.environ.get("BASALT_SKIP_VLAB") == "1":
         return "BASALT_SKIP_VLAB=1 is set"
-    if not os.path.exists("/dev/kvm") and not shutil.which("qemu-system-x86_64"):
-        return None
     return None
 
 
@@ -443,6 +441,9 @@ def print_fixtures(results):
 
 
 def cmd_run(args):
+    reason = skip_reason_if_disabled()
+    if reason:
+        raise LabUnavailable(reason)
     if not args.argv:
         say("usage: vlab.py run [--timeout S] -- PROGRAM ARGS...")
         return 2
@@ -592,6 +593,9 @@ def cmd_batch_entry(args):
 
 
 def cmd_shell(args):
+    reason = skip_reason_if_disabled()
+    if reason:
+        raise LabUnavailable(reason)
     lab = build()
     build_dir = args.build or default_build_dir()
     results = os.path.join(build_dir or cache_dir(), "vlab", "runs", "shell")
@@ -619,9 +623,8 @@ def main():
     r.add_argument("--build", help="the build tree (writable in the lab; default: build/ of the source tree)")
     r.add_argument("--results", help="where the run's files go (default: BUILD/vlab/runs/run)")
     r.add_argument("--timeout", type=int, default=300, help="seconds the program may run (default 300)")
+    r.add_argument("--boot-timeout", type=int, default=int(os.environ.get("BASALT_VLAB_BOOT_TIMEOUT", "120")))
     r.add_argument("argv", nargs=argparse.REMAINDER)
-    for p in (r,):
-        p.add_argument("--boot-timeout", type=int, default=int(os.environ.get("BASALT_VLAB_BOOT_TIMEOUT", "120")))
     bt = sub.add_parser("batch")
     bt.add_argument("--jobs", required=True)
     bt.add_argument("--results", required=True)
