@@ -223,6 +223,10 @@ def build(force=False):
             if os.path.isdir(lab):
                 shutil.rmtree(lab)
             os.replace(out, lab)
+        # Labs of older inputs are not used again (a running qemu has its kernel in memory).
+        for old in glob.glob(os.path.join(cache, "lab-*")):
+            if old != lab:
+                shutil.rmtree(old, ignore_errors=True)
         say(f"lab built in {time.monotonic() - started:.1f} s: {lab}")
         return lab
 

@@ -298,8 +298,8 @@ TEST(LabDrm, VirtioGpuModesetsAndFlips) {
   // one and never reaches end of file.
   const auto run =
       test::run({"/bin/sh", "-c",
-                 "rm -f /tmp/kmscube.in; mkfifo /tmp/kmscube.in; exec kmscube -D " + card + " -c 10 <>/tmp/kmscube.in"},
-                {}, 120s);
+                 "rm -f /tmp/kmscube.in; mkfifo /tmp/kmscube.in; exec kmscube -D " + card + " -c 5 <>/tmp/kmscube.in"},
+                {}, 240s);
   EXPECT_EQ(run.exitCode, 0) << run.output;
   EXPECT_EQ(run.output.find("failed to set mode"), std::string::npos) << run.output;
   EXPECT_EQ(run.output.find("user interrupted"), std::string::npos) << run.output;
