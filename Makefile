@@ -8,6 +8,8 @@
 #   make format     reformat the sources with clang-format
 #   make sanitize   build with AddressSanitizer + UBSan and run the unit, contract and render tiers
 #   make fuzz       build the libFuzzer targets with clang-19 and run each for FUZZ_SECONDS
+#   make vlab       build and run the virtual-lab tests (qemu with real kernel drivers) alone
+#   make vlab-shell an interactive shell inside the virtual lab, with the build tree
 
 BUILD ?= build
 BUILD_TYPE ?= RelWithDebInfo
@@ -15,7 +17,7 @@ RUN_ARGS ?= --seconds 10
 CMAKE_ARGS ?=
 FUZZ_SECONDS ?= 60
 
-.PHONY: all setup configure build run test bench lint format sanitize fuzz clean
+.PHONY: all setup configure build run test bench lint format sanitize fuzz vlab vlab-shell clean
 
 all: build
 
@@ -54,6 +56,12 @@ sanitize: setup
 
 fuzz: setup
 	@scripts/fuzz.sh $(FUZZ_SECONDS)
+
+vlab: build
+	@scripts/run-tests.sh $(BUILD) -L vlab
+
+vlab-shell: setup
+	@sim/vlab/shell $(if $(wildcard $(BUILD)),--build $(BUILD))
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-sanitize build-fuzz out
