@@ -12,8 +12,8 @@
 
 namespace basalt::render {
 
-/// \brief One of LAVA's eight line patterns as a repeating pixel mask: bit i (from the segment's
-/// first end) is drawn when set. Patterns scale with the line width.
+/// \brief One of LAVA's eight line patterns as a repeating pixel mask: bit i (counted along the
+/// line's major screen axis) is drawn when set. Patterns scale with the line width.
 struct LinePatternMask {
   std::uint32_t mask = 0;
   int period = 1;  ///< pixels, 1..32

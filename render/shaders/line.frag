@@ -1,6 +1,6 @@
-// Lines and edges, fragment stage: round ends, antialiased coverage, the line pattern (on a
-// 32-pixel mask, restarting at each segment's first end, in units of the line width), then the
-// shared epilogue.
+// Lines and edges, fragment stage: round ends, antialiased coverage, the line pattern (a
+// repeating mask of up to 32 steps, each step a pixel times the line width), then the shared
+// epilogue.
 
 uniform vec4 uColor;
 uniform vec4 uAltColor;
@@ -51,7 +51,10 @@ void main() {
 
   vec4 c = vColor.r < 0.0 ? uColor : vColor;
   if (uStyle != 0) {
-    int bit = int(floor(max(along, 0.0) / uPatternScale)) % uPatternPeriod;
+    // Counted along the line's major screen axis, as OpenGL's line stipple counts it, so that
+    // the pattern runs on across the joints of polylines and tessellated curves.
+    float axis = abs(dir.x) >= abs(dir.y) ? p.x : p.y;
+    int bit = int(floor((axis + 8192.0) / uPatternScale)) % uPatternPeriod;
     bool on = ((uPatternMask >> bit) & 1) != 0;
     if (!on) {
       if (uStyle == 1) discard;

@@ -136,7 +136,9 @@ void main() {
     vec2 outerThis = dot(nrm, v) > 0.0 ? -nrm : nrm;
     vec2 outerOther = normalize(-(u - dot(u, v) * v));
     if (which == 0) {
-      p = E;
+      // The apex is this segment's inner corner, which both segments share, so that the two half
+      // bevels and the two quads leave no gap around the joint.
+      p = corner(E, u, v, true, -outerThis, halfWidth, extension);
     } else if (which == 1) {
       p = E + outerThis * halfWidth;
     } else {

@@ -150,12 +150,80 @@ std::shared_ptr<runtime::Mesh> makeSphere(float radius, int rings, int segments,
     for (std::uint32_t s = 0; s < static_cast<std::uint32_t>(segments); ++s) {
       const std::uint32_t a = r * stride + s, b = a + stride, c = b + 1, d = a + 1;
       for (std::uint32_t v : {a, b, c, a, c, d}) mesh->triangles.push_back(v);
+      // Each quad's outline: the grid of meridians and parallels.
+      for (std::uint32_t v : {a, b, b, c, c, d, d, a}) mesh->edges.push_back(v);
     }
   }
   runtime::MeshPart part;
   part.name = partName;
+  part.edgeIndexCount = static_cast<std::uint32_t>(mesh->edges.size());
   part.triangleIndexCount = static_cast<std::uint32_t>(mesh->triangles.size());
   part.facetCount = part.triangleIndexCount / 3;
+  mesh->parts.push_back(part);
+  return mesh;
+}
+
+std::shared_ptr<runtime::Mesh> combine(const std::vector<std::shared_ptr<runtime::Mesh>>& meshes) {
+  auto out = std::make_shared<runtime::Mesh>();
+  for (const auto& m : meshes) {
+    const auto base = static_cast<std::uint32_t>(out->positions.size());
+    const auto tri = static_cast<std::uint32_t>(out->triangles.size());
+    const auto edge = static_cast<std::uint32_t>(out->edges.size());
+    const auto line = static_cast<std::uint32_t>(out->lines.size());
+    const auto point = static_cast<std::uint32_t>(out->points.size());
+    const std::size_t n = m->positions.size();
+    out->positions.insert(out->positions.end(), m->positions.begin(), m->positions.end());
+    auto fill = [n](auto& into, const auto& from, auto fallback) {
+      if (from.size() == n) {
+        into.insert(into.end(), from.begin(), from.end());
+      } else {
+        into.insert(into.end(), n, fallback);
+      }
+    };
+    fill(out->normals, m->normals, Vec3{0, 0, 1});
+    fill(out->texcoords, m->texcoords, Vec2{0, 0});
+    if (!m->colors.empty() || !out->colors.empty()) {
+      out->colors.resize(base, Vec4{1, 1, 1, 1});
+      fill(out->colors, m->colors, Vec4{1, 1, 1, 1});
+    }
+    for (std::uint32_t v : m->triangles) out->triangles.push_back(base + v);
+    for (std::uint32_t v : m->edges) out->edges.push_back(base + v);
+    for (std::uint32_t v : m->lines) out->lines.push_back(base + v);
+    for (std::uint32_t v : m->points) out->points.push_back(base + v);
+    for (runtime::MeshPart p : m->parts) {
+      p.firstTriangleIndex += tri;
+      p.firstEdgeIndex += edge;
+      p.firstLineIndex += line;
+      p.firstPointIndex += point;
+      out->parts.push_back(p);
+    }
+  }
+  return out;
+}
+
+std::shared_ptr<runtime::Mesh> makePolyline(const std::vector<Vec3>& points, const std::string& partName) {
+  auto mesh = std::make_shared<runtime::Mesh>();
+  mesh->positions = points;
+  mesh->normals.assign(points.size(), Vec3{0, 0, 1});
+  for (std::uint32_t i = 0; i + 1 < points.size(); ++i) {
+    mesh->lines.push_back(i);
+    mesh->lines.push_back(i + 1);
+  }
+  runtime::MeshPart part;
+  part.name = partName;
+  part.lineIndexCount = static_cast<std::uint32_t>(mesh->lines.size());
+  mesh->parts.push_back(part);
+  return mesh;
+}
+
+std::shared_ptr<runtime::Mesh> makePoints(const std::vector<Vec3>& points, const std::string& partName) {
+  auto mesh = std::make_shared<runtime::Mesh>();
+  mesh->positions = points;
+  mesh->normals.assign(points.size(), Vec3{0, 0, 1});
+  for (std::uint32_t i = 0; i < points.size(); ++i) mesh->points.push_back(i);
+  runtime::MeshPart part;
+  part.name = partName;
+  part.pointIndexCount = static_cast<std::uint32_t>(points.size());
   mesh->parts.push_back(part);
   return mesh;
 }

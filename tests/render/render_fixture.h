@@ -58,6 +58,12 @@ Vec2 worldToPixel(const runtime::ViewTransforms& view, const Vec3& world);
 std::shared_ptr<runtime::Mesh> makeQuad(float half = 1.0f, float z = 0.0f, int n = 1, const std::string& part = "quad");
 /// \brief A UV sphere with smooth normals.
 std::shared_ptr<runtime::Mesh> makeSphere(float radius, int rings, int segments, const std::string& part = "sphere");
+/// \brief One mesh holding the parts of all `meshes` (index ranges moved along).
+std::shared_ptr<runtime::Mesh> combine(const std::vector<std::shared_ptr<runtime::Mesh>>& meshes);
+/// \brief A polyline through `points` (consecutive segments sharing vertices), as mesh lines.
+std::shared_ptr<runtime::Mesh> makePolyline(const std::vector<Vec3>& points, const std::string& part);
+/// \brief Loose points, as mesh points.
+std::shared_ptr<runtime::Mesh> makePoints(const std::vector<Vec3>& points, const std::string& part);
 /// \brief A show holding `mesh` at its original size (no normalisation), lights as LAVA sets them.
 runtime::Show showOf(std::shared_ptr<const runtime::Mesh> mesh);
 /// \brief Switches every light off.
