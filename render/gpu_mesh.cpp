@@ -205,6 +205,13 @@ std::unique_ptr<GpuMesh> GpuMesh::upload(const std::shared_ptr<const runtime::Me
     }
     all.insert(all.end(), distinct.begin(), distinct.end());
   }
+  gpu->provokingFacetNormals_ = true;
+  for (std::size_t t = 0; t + 2 < mesh.triangles.size() && gpu->provokingFacetNormals_; t += 3) {
+    const std::uint32_t a = mesh.triangles[t], b = mesh.triangles[t + 1], c = mesh.triangles[t + 2];
+    if (a >= n || b >= n || c >= n) continue;
+    const Vec3 fn = facetNormal(mesh, normals, a, b, c);
+    gpu->provokingFacetNormals_ = dot(fn, normalize(normals[c])) > 0.99999f;
+  }
   gpu->indices_ = uploadBuffer(GL_ELEMENT_ARRAY_BUFFER, all.data(), all.size());
   glBindVertexArray(0);
   log::debug(kLogRenderMesh, "uploaded mesh {} ({} vertices, {} triangles)", mesh.id(), n, mesh.triangleCount());

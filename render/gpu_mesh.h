@@ -39,6 +39,9 @@ class GpuMesh {
   [[nodiscard]] bool alive() const { return !source_.expired(); }
   [[nodiscard]] const std::vector<GpuPart>& parts() const { return parts_; }
   [[nodiscard]] bool hasColors() const { return hasColors_; }
+  /// \brief True when the last vertex of every triangle already carries the facet's normal (flat
+  /// models, the colour cube): per-facet illumination then draws the indexed stream as it is.
+  [[nodiscard]] bool provokingNormalsAreFacetNormals() const { return provokingFacetNormals_; }
   [[nodiscard]] GLuint indexedVao() const { return vao_.id(); }
   /// \brief Byte offsets into the index buffer of each index family.
   [[nodiscard]] std::size_t edgeOffset() const { return edgeOffset_; }
@@ -67,6 +70,7 @@ class GpuMesh {
   std::size_t edgeOffset_ = 0, lineOffset_ = 0, pointOffset_ = 0, markerOffset_ = 0;
   std::vector<GpuPart> parts_;
   bool hasColors_ = false;
+  bool provokingFacetNormals_ = false;
 
   gl::VertexArray facetVao_;
   gl::Buffer facetBuffer_;

@@ -187,7 +187,7 @@ struct Renderer::Impl {
   Size destinationSize;
   std::shared_ptr<runtime::Mesh> floorMeshes[3];
   std::vector<BlendedItem> blended;
-  std::vector<std::string> warnedNames;
+  std::vector<std::pair<std::string, std::string>> warned;  // (what, name) said once
   bool warnedRasterOp[16] = {};
   std::vector<std::uint8_t> readScratch;
   std::vector<std::uint32_t> accumulation;
@@ -210,19 +210,25 @@ struct Renderer::Impl {
     }
   }
 
-  void warnOnce(const std::string& key, std::string_view message) {
-    if (std::find(warnedNames.begin(), warnedNames.end(), key) != warnedNames.end()) return;
-    warnedNames.push_back(key);
-    log::warn(kLogRender, "{}", message);
+  /// Logs `message()` the first time (`kind`, `name`) comes up; allocates nothing afterwards.
+  template <typename Message>
+  void warnOnce(std::string_view kind, std::string_view name, Message&& message) {
+    for (const auto& [k, n] : warned) {
+      if (k == kind && n == name) return;
+    }
+    warned.emplace_back(std::string(kind), std::string(name));
+    log::warn(kLogRender, "{}", message());
   }
 
+  /// The texture `name` names, or null (warned once) when it is not loaded.
   const TextureView* texture(const std::string& name, std::string_view what, std::string_view owner) {
     if (name.empty()) return nullptr;
     const TextureView* view = self.textures_.find(name);
     if (!view || view->id == 0) {
-      warnOnce(fmt::format("texture:{}:{}", what, name),
-               fmt::format("{} '{}' of {} is not loaded; drawing without it (load it, or check the name)", what, name,
-                           owner));
+      warnOnce(what, name, [&] {
+        return fmt::format("{} '{}' of {} is not loaded; drawing without it (load it, or check the name)", what, name,
+                           owner == "show" ? std::string("the show") : fmt::format("part '{}'", owner));
+      });
       return nullptr;
     }
     return view;
@@ -235,9 +241,9 @@ struct Renderer::Impl {
   RasterPath rasterPathFor(runtime::RasterOp op) {
     if (rasterOpIsDirect(op)) return RasterPath::kDirect;
     if (self.caps_.framebufferFetch) return RasterPath::kFetch;
-    auto& warned = warnedRasterOp[static_cast<std::size_t>(op)];
-    if (!warned) {
-      warned = true;
+    bool& said = warnedRasterOp[static_cast<std::size_t>(op)];
+    if (!said) {
+      said = true;
       log::warn(kLogRender,
                 "render.raster_op = {} cannot be drawn exactly on this GPU (no framebuffer fetch): Basalt "
                 "combines each part with a copy of the frame taken just before it, so where a part's own faces "
@@ -342,16 +348,14 @@ struct Renderer::Impl {
     key.twoSided = faceDist && style.render.faceCulling != FaceCulling::kBack;
 
     const bool texturing = show.texture().source != runtime::TextureSource::kOff;
-    const TextureView* colorMap =
-        texturing ? texture(d.part->texture, "texture", fmt::format("part '{}'", d.part->name)) : nullptr;
+    const TextureView* colorMap = texturing ? texture(d.part->texture, "texture", d.part->name) : nullptr;
     const TextureView* reflection =
-        texturing ? texture(d.part->reflectionTexture, "reflection map", fmt::format("part '{}'", d.part->name))
-                  : nullptr;
+        texturing ? texture(d.part->reflectionTexture, "reflection map", d.part->name) : nullptr;
     const bool patternFill = front.fillStyle == runtime::FillStyle::kPattern;
     if (patternFill && !colorMap) {
-      warnOnce(
-          fmt::format("pattern:{}", d.part->name),
-          fmt::format("part '{}' has fill style 'pattern' but no texture to tile; drawing it solid", d.part->name));
+      warnOnce("pattern fill", d.part->name, [&] {
+        return fmt::format("part '{}' has fill style 'pattern' but no texture to tile; drawing it solid", d.part->name);
+      });
     }
     const bool vltm = colorMap && !patternFill && show.texture().method == runtime::TextureMethod::kVertexLevel;
     const bool stipple =
@@ -405,10 +409,12 @@ struct Renderer::Impl {
       glBindVertexArray(gpu.vltmVao());
       gpu.bindVltm(mp.firstTriangleIndex / 3);
       glDrawArraysInstanced(GL_TRIANGLES, 0, 3 * segments * segments, triangles / 3);
-    } else if (key.shading == Shading::kFacet) {
+    } else if (key.shading == Shading::kFacet && !gpu.provokingNormalsAreFacetNormals()) {
+      glUniform1i(u.facetStream, 1);
       glBindVertexArray(gpu.facetVao());
       glDrawArrays(GL_TRIANGLES, static_cast<GLint>(mp.firstTriangleIndex), triangles);
     } else {
+      glUniform1i(u.facetStream, 0);
       glBindVertexArray(gpu.indexedVao());
       glDrawElements(GL_TRIANGLES, triangles, GL_UNSIGNED_INT,
                      indexOffset(std::size_t{mp.firstTriangleIndex} * sizeof(std::uint32_t)));
@@ -700,7 +706,7 @@ struct Renderer::Impl {
     const TextureView* image = nullptr;
     if (kind == runtime::BackgroundKind::kImage || kind == runtime::BackgroundKind::kSkybox) {
       image = texture(show.backgroundImage(), kind == runtime::BackgroundKind::kImage ? "background image" : "skybox",
-                      "the show");
+                      "show");
       if (image) mode = kind == runtime::BackgroundKind::kImage ? 1 : 2;
     } else if (kind == runtime::BackgroundKind::kEarthSky && !earthSkyClearOnly) {
       mode = 3;

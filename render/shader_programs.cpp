@@ -75,6 +75,7 @@ void locate(GLuint p, ProgramUniforms& u) {
   u.backLit = at("uBackLit");
   u.frontLit = at("uFrontLit");
   u.texcoordFlip = at("uTexcoordFlip");
+  u.facetStream = at("uFacetStream");
   surface("uFront", u.front);
   surface("uBack", u.back);
   u.textureMode = at("uTextureMode");

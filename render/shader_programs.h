@@ -53,6 +53,7 @@ struct ProgramUniforms {
     GLint color = -1, specularColor = -1, ka = -1, kd = -1, ks = -1, power = -1, components = -1, alpha = -1;
   };
   GLint model = -1, normalMatrix = -1, colorSource = -1, backLit = -1, frontLit = -1, texcoordFlip = -1;
+  GLint facetStream = -1;
   SurfaceLocations front, back;
   GLint textureMode = -1, textureSize = -1, stipple = -1, opaqueStipple = -1, screenDoor = -1;
   GLint blendToBackground = -1, rasterOp = -1;

@@ -23,6 +23,7 @@ uniform Surface uBack;
 uniform int uColorSource;  // 0: the surface colour, 1: the vertex (or facet) colour
 uniform int uBackLit;      // 1: light back faces (TWO_SIDED)
 uniform vec2 uTexcoordFlip;  // t' = y + x * t: images are stored top row first
+uniform int uFacetStream;    // 1: drawing the de-indexed facet stream
 
 #if defined(SHADE_FACET) || defined(SHADE_UNLIT_FLAT)
 flat out vec4 vFront;
@@ -64,8 +65,10 @@ void main() {
 #endif
 #elif defined(SHADE_FACET) || defined(SHADE_VERTEX)
 #ifdef SHADE_FACET
-  // GLES takes a flat value from the last vertex of each triangle: light only that one.
-  bool provoking = (gl_VertexID % 3) == 2;
+  // GLES takes a flat value from the last vertex of each triangle: in the facet stream (three
+  // vertices per triangle, in order) light only that one; an indexed mesh whose last vertices
+  // carry the facet normals lights each of its vertices once.
+  bool provoking = uFacetStream == 0 || (gl_VertexID % 3) == 2;
 #else
   bool provoking = true;
 #endif

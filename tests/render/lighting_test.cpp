@@ -316,5 +316,33 @@ TEST_F(Illuminations, FaceDistinguishingLightsTheBackWithItsOwnAttributes) {
   EXPECT_LT(channel(image, 128, 128, 0), 0.05f);
 }
 
+TEST_F(Illuminations, FaceCullingAndHiddenSurfaceRemoval) {
+  // Two squares, the near one (z = 0.5, green) drawn first, the far one (z = 0, red) second.
+  auto nearSquare = makeQuad(0.5f, 0.5f, 1, "near");
+  auto farSquare = makeQuad(0.8f, 0.0f, 1, "far");
+  Show show = showOf(combine({nearSquare, farSquare}));
+  show.editGlobalStyle([](PartStyle& s) { s.front.illumination = Illumination::kNone; });
+  show.editPartStyle(*show.findPart("near"), runtime::AttrId::kFrontColor,
+                     [](PartStyle& s) { s.front.color = {0, 1, 0}; });
+  show.editPartStyle(*show.findPart("far"), runtime::AttrId::kFrontColor,
+                     [](PartStyle& s) { s.front.color = {1, 0, 0}; });
+  const runtime::ViewTransforms view = testCamera();
+  Image image = render(show, view);
+  EXPECT_EQ(image.at(128, 128, 1), 255) << "hidden surface removal: the near square wins";
+  show.editGlobalStyle([](PartStyle& s) { s.render.hiddenSurfaceRemoval = false; });
+  image = render(show, view);
+  EXPECT_EQ(image.at(128, 128, 0), 255) << "without it the part drawn last wins";
+  // Both squares face the camera: culling front faces removes them, culling back faces keeps them.
+  show.editGlobalStyle([](PartStyle& s) {
+    s.render.hiddenSurfaceRemoval = true;
+    s.render.faceCulling = runtime::FaceCulling::kFront;
+  });
+  image = render(show, view);
+  EXPECT_EQ(image.at(128, 128, 0) + image.at(128, 128, 1), 0) << "front faces culled";
+  show.editGlobalStyle([](PartStyle& s) { s.render.faceCulling = runtime::FaceCulling::kBack; });
+  image = render(show, view);
+  EXPECT_EQ(image.at(128, 128, 1), 255) << "back-face culling keeps faces that face the eye";
+}
+
 }  // namespace
 }  // namespace basalt::test
