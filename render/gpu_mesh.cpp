@@ -413,11 +413,14 @@ void GpuMesh::bindVltm(std::uint32_t firstTriangle) {
   const std::size_t base = std::size_t{firstTriangle} * sizeof(VltmTriangle);
   const GLsizei stride = sizeof(VltmTriangle);
   for (GLuint k = 0; k < 3; ++k) {
-    glVertexAttribPointer(k, 3, GL_FLOAT, GL_FALSE, stride, byteOffset(base + offsetof(VltmTriangle, p) + k * 12));
-    glVertexAttribPointer(3 + k, 3, GL_FLOAT, GL_FALSE, stride, byteOffset(base + offsetof(VltmTriangle, n) + k * 12));
-    glVertexAttribPointer(6 + k, 2, GL_FLOAT, GL_FALSE, stride, byteOffset(base + offsetof(VltmTriangle, t) + k * 8));
+    glVertexAttribPointer(k, 3, GL_FLOAT, GL_FALSE, stride,
+                          byteOffset(base + offsetof(VltmTriangle, p) + std::size_t{k} * 12));
+    glVertexAttribPointer(3 + k, 3, GL_FLOAT, GL_FALSE, stride,
+                          byteOffset(base + offsetof(VltmTriangle, n) + std::size_t{k} * 12));
+    glVertexAttribPointer(6 + k, 2, GL_FLOAT, GL_FALSE, stride,
+                          byteOffset(base + offsetof(VltmTriangle, t) + std::size_t{k} * 8));
     glVertexAttribPointer(9 + k, 4, GL_UNSIGNED_BYTE, GL_TRUE, stride,
-                          byteOffset(base + offsetof(VltmTriangle, c) + k * 4));
+                          byteOffset(base + offsetof(VltmTriangle, c) + std::size_t{k} * 4));
   }
 }
 

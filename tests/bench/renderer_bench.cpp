@@ -62,6 +62,12 @@ Bench& bench() {
   return b;
 }
 
+/// Reports a failed step (the figures that follow are then meaningless, and say so by being absent).
+template <typename T>
+void check(const Result<T>& r) {
+  if (!r) std::fprintf(stderr, "renderer bench: %s\n", r.error().describe().c_str());
+}
+
 /// A UV sphere of 224 x 224 quads: 100 352 triangles, smooth normals.
 std::shared_ptr<runtime::Mesh> bigSphere() {
   static std::shared_ptr<runtime::Mesh> mesh = [] {
@@ -329,12 +335,12 @@ void drawBasalt(const runtime::Show& show) { bench().renderer->drawShow(show, {0
 /// Largest channel difference between Basalt's and the minimal program's picture.
 int pictureDifference(const runtime::Show& show, const Minimal& m) {
   Image a, b;
-  (void)bench().output->beginFrame();
+  check(bench().output->beginFrame());
   drawBasalt(show);
-  (void)bench().output->readBack(a);
-  (void)bench().output->beginFrame();
+  check(bench().output->readBack(a));
+  check(bench().output->beginFrame());
   drawMinimal(m);
-  (void)bench().output->readBack(b);
+  check(bench().output->readBack(b));
   return compareImages(a, b, 2).maxChannelDelta;
 }
 
@@ -346,11 +352,11 @@ void timeFrames(benchmark::State& state, Draw&& draw) {
     state.SkipWithError(("no headless EGL: " + bench().problem).c_str());
     return;
   }
-  (void)bench().output->beginFrame();
+  check(bench().output->beginFrame());
   draw();
   glFinish();
   for (auto _ : state) {
-    (void)bench().output->beginFrame();
+    check(bench().output->beginFrame());
     draw();
     glFinish();
   }
@@ -447,18 +453,18 @@ AllocationFigures countAllocations(int kFrames) {
   if (!bench().renderer) return f;
   f.frames = kFrames;
   Image texture = Image::make(16, 16, 3);
-  (void)bench().renderer->textures().setImage("bench texture", texture);
+  check(bench().renderer->textures().setImage("bench texture", texture));
 
   // The renderer alone, every feature.
   runtime::Show show = everythingShow();
   for (int i = 0; i < 10; ++i) {
-    (void)bench().output->beginFrame();
+    check(bench().output->beginFrame());
     bench().renderer->drawShow(show, {0, 0, kWidth, kHeight});
     show.advanceFrame();
   }
   std::uint64_t before = bench::allocationCount();
   for (int i = 0; i < kFrames; ++i) {
-    (void)bench().output->beginFrame();
+    check(bench().output->beginFrame());
     bench().renderer->drawShow(show, {0, 0, kWidth, kHeight});
     show.performance().recordFrame(bench().renderer->takeFrameCounts(), Nanos{std::int64_t{i} * 16'666'667});
     show.advanceFrame();
@@ -473,11 +479,11 @@ AllocationFigures countAllocations(int kFrames) {
   runtime::Show defaultShow = runtime::Show::makeDefault();
   {
     kiosk::FrameLoop warmUp({60, 10}, clock, &clock, **loop, defaultShow, *bench().output, *bench().renderer);
-    (void)warmUp.run();
+    check(warmUp.run());
   }
   kiosk::FrameLoop frameLoop({60, kFrames}, clock, &clock, **loop, defaultShow, *bench().output, *bench().renderer);
   before = bench::allocationCount();
-  (void)frameLoop.run();
+  check(frameLoop.run());
   f.frameLoop = static_cast<double>(bench::allocationCount() - before) / kFrames;
   return f;
 }

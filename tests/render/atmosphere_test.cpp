@@ -57,10 +57,10 @@ Show depthSquares() {
 class Atmosphere : public RenderTest {
  protected:
   /// Renders and returns the colour at the centre of square i.
-  std::array<std::array<float, 3>, 4> squareColours(const Show& show) {
+  std::array<std::array<double, 3>, 4> squareColours(const Show& show) {
     const runtime::ViewTransforms view = testCamera(f32(kEye), 1.0f, f32(kNear), f32(kFar));
     const Image image = render(show, view);
-    std::array<std::array<float, 3>, 4> out{};
+    std::array<std::array<double, 3>, 4> out{};
     for (int i = 0; i < 4; ++i) {
       const float s = f32(kDepths[i] / kEye);
       const Vec2 p = worldToPixel(view, {(-0.6f + 0.4f * static_cast<float>(i)) * s, 0, f32(kEye - kDepths[i])});
@@ -71,11 +71,12 @@ class Atmosphere : public RenderTest {
     return out;
   }
 
-  static void expectMix(const std::array<float, 3>& got, double keep, const runtime::Color3& towards,
+  static void expectMix(const std::array<double, 3>& got, double keep, const runtime::Color3& towards,
                         const std::string& what) {
     // C' = keep * C + (1 - keep) * towards, with C white.
-    const double want[3] = {keep + (1 - keep) * double{towards.r}, keep + (1 - keep) * double{towards.g},
-                            keep + (1 - keep) * double{towards.b}};
+    const double want[3] = {keep + (1 - keep) * static_cast<double>(towards.r),
+                            keep + (1 - keep) * static_cast<double>(towards.g),
+                            keep + (1 - keep) * static_cast<double>(towards.b)};
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(got[static_cast<std::size_t>(c)], want[c], 2.0 / 255) << what << " ch " << c;
   }
@@ -104,15 +105,16 @@ TEST_F(Atmosphere, ScaledDepthCueBetweenTheReferencePlanes) {
   const auto got = squareColours(show);
   for (int i = 0; i < 4; ++i) {
     const double zv = (kNear + kFar - 2.0 * kDepths[i]) / (kFar - kNear);  // +1 near .. -1 far
-    const double front = dc.frontRefPlane, back = dc.backRefPlane, maxS = dc.maxScale, minS = dc.minScale;
+    const double front = wide(dc.frontRefPlane), back = wide(dc.backRefPlane), maxS = wide(dc.maxScale),
+                 minS = wide(dc.minScale);
     double s = minS + (maxS - minS) * (zv - back) / (front - back);
     if (zv >= front) s = maxS;
     if (zv <= back) s = minS;
     expectMix(got[static_cast<std::size_t>(i)], s, dc.color, fmt::format("square {} at VDC z {}", i, zv));
   }
   // The outer squares are outside the planes (clamped), the inner ones between them.
-  EXPECT_NEAR(double{got[0][1]}, 0.9, 2.0 / 255);
-  EXPECT_NEAR(double{got[3][1]}, 0.2, 2.0 / 255);
+  EXPECT_NEAR(got[0][1], 0.9, 2.0 / 255);
+  EXPECT_NEAR(got[3][1], 0.2, 2.0 / 255);
 }
 
 TEST_F(Atmosphere, DepthCueToTheBackgroundColour) {
@@ -144,7 +146,7 @@ TEST_F(Atmosphere, FogFunctions) {
     for (int i = 0; i < 4; ++i) {
       const double z = kDepths[i];
       double f = 0;
-      const double start = fog.start, end = fog.end, density = fog.density;
+      const double start = wide(fog.start), end = wide(fog.end), density = wide(fog.density);
       if (c.mode == runtime::FogMode::kLinear) f = (end - z) / (end - start);
       if (c.mode == runtime::FogMode::kExp) f = std::exp(-density * z);
       if (c.mode == runtime::FogMode::kExp2) f = std::exp(-std::pow(density * z, 2));
@@ -165,7 +167,7 @@ TEST_F(Atmosphere, DepthCueThenFog) {
   const double z = (kDepths[2] - kNear) / (kFar - kNear);
   const double cued = 1 - z;  // white towards black
   const double f = std::exp(-0.2 * kDepths[2]);
-  EXPECT_NEAR(double{got[2][0]}, f * cued + (1 - f) * 1.0, 2.0 / 255);
+  EXPECT_NEAR(got[2][0], f * cued + (1 - f) * 1.0, 2.0 / 255);
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "render_fixture.h"
 
 namespace basalt::test {
@@ -68,11 +70,12 @@ TEST_F(Goldens, Markers) {
   const runtime::ViewTransforms view = testCamera();
   const Image image = render(show, view);
   // The plus marker's centre is lit, a point diagonally off it is not; the square's centre is not.
+  auto pixel = [](float v) { return static_cast<std::uint32_t>(std::lround(v)); };
   const Vec2 plus = worldToPixel(view, {-0.24f, 0.45f, 0});
-  EXPECT_GT(image.at(static_cast<std::uint32_t>(plus.x + 0.5f), static_cast<std::uint32_t>(plus.y + 0.5f), 0), 200);
-  EXPECT_EQ(image.at(static_cast<std::uint32_t>(plus.x + 4.5f), static_cast<std::uint32_t>(plus.y + 4.5f), 0), 0);
+  EXPECT_GT(image.at(pixel(plus.x), pixel(plus.y), 0), 200);
+  EXPECT_EQ(image.at(pixel(plus.x + 4), pixel(plus.y + 4), 0), 0);
   const Vec2 square = worldToPixel(view, {-0.24f, -0.45f, 0});
-  EXPECT_EQ(image.at(static_cast<std::uint32_t>(square.x + 0.5f), static_cast<std::uint32_t>(square.y + 0.5f), 1), 0);
+  EXPECT_EQ(image.at(pixel(square.x), pixel(square.y), 1), 0);
   expectGolden(image, "markers");
 }
 
@@ -153,7 +156,8 @@ TEST_F(Goldens, StipplePatterns) {
   parts.push_back(makeQuad(0.95f, -0.5f, 1, "behind"));
   for (int i = 0; i < 12; ++i) {
     auto q = makeQuad(0.2f, 0.0f, 1, fmt::format("stipple {}", i));
-    const float x = -0.7f + 0.47f * static_cast<float>(i % 4), y = 0.62f - 0.62f * static_cast<float>(i / 4);
+    const int row = i / 4, column = i % 4;
+    const float x = -0.7f + 0.47f * static_cast<float>(column), y = 0.62f - 0.62f * static_cast<float>(row);
     for (Vec3& p : q->positions) p = {p.x + x, p.y + y, p.z};
     parts.push_back(q);
   }

@@ -30,7 +30,7 @@ class Backgrounds : public RenderTest {
                            const std::string& what) {
     const float want[3] = {c.r, c.g, c.b};
     for (std::uint32_t k = 0; k < 3; ++k) {
-      EXPECT_NEAR(image.at(x, y, k), double{want[k]} * 255.0, tolerance + 0.5) << what << " channel " << k;
+      EXPECT_NEAR(image.at(x, y, k), static_cast<double>(want[k]) * 255.0, tolerance + 0.5) << what << " channel " << k;
     }
   }
 };
@@ -41,7 +41,7 @@ Image quadrants() {
   for (std::uint32_t y = 0; y < 64; ++y) {
     for (std::uint32_t x = 0; x < 64; ++x) {
       const bool right = x >= 32, bottom = y >= 32;
-      std::uint8_t* p = image.row(y) + x * 3;
+      std::uint8_t* p = image.row(y) + std::size_t{x} * 3;
       p[0] = static_cast<std::uint8_t>(right == bottom ? 255 : 0);
       p[1] = static_cast<std::uint8_t>(right ? 255 : 0);
       p[2] = static_cast<std::uint8_t>(bottom ? 255 : 0);
@@ -84,7 +84,7 @@ Image skyboxAtlas() {
   for (std::uint32_t y = 0; y < 64; ++y) {
     for (std::uint32_t x = 0; x < 96; ++x) {
       const std::uint32_t cell = (y / 32) * 3 + x / 32;
-      std::uint8_t* p = image.row(y) + x * 3;
+      std::uint8_t* p = image.row(y) + std::size_t{x} * 3;
       const Color3 c = kFaceColour[cell];
       p[0] = static_cast<std::uint8_t>(std::lround(c.r * 255));
       p[1] = static_cast<std::uint8_t>(std::lround(c.g * 255));
@@ -118,8 +118,10 @@ TEST_F(Backgrounds, SkyboxShowsTheFaceOfEachDirection) {
     const Image image = render(show, lookingAlong(dir));
     const Color3 c = kFaceColour[face];
     // The red and green channels identify the face (blue carries the ramp on the top row).
-    EXPECT_NEAR(image.at(128, 128, 0), double{c.r} * 255.0, 2.5) << "looking along " << dir.x << dir.y << dir.z;
-    EXPECT_NEAR(image.at(128, 128, 1), double{c.g} * 255.0, 2.5) << "looking along " << dir.x << dir.y << dir.z;
+    EXPECT_NEAR(image.at(128, 128, 0), static_cast<double>(c.r) * 255.0, 2.5)
+        << "looking along " << dir.x << dir.y << dir.z;
+    EXPECT_NEAR(image.at(128, 128, 1), static_cast<double>(c.g) * 255.0, 2.5)
+        << "looking along " << dir.x << dir.y << dir.z;
   }
 }
 

@@ -28,8 +28,8 @@ using runtime::Show;
 struct D3 {
   double x = 0, y = 0, z = 0;
 };
-D3 d3(const Vec3& v) { return {v.x, v.y, v.z}; }
-D3 d3(const Color3& c) { return {c.r, c.g, c.b}; }
+D3 d3(const Vec3& v) { return {wide(v.x), wide(v.y), wide(v.z)}; }
+D3 d3(const Color3& c) { return {wide(c.r), wide(c.g), wide(c.b)}; }
 D3 operator+(D3 a, D3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 D3 operator-(D3 a, D3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 D3 operator*(D3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
@@ -47,7 +47,7 @@ D3 reference(const Show& show, const runtime::SurfaceAttributes& s, D3 P, D3 N, 
     if (!light.on) continue;
     const D3 Lc = d3(light.color);
     if (light.type == LightType::kAmbient) {
-      if (s.lightComponents & runtime::kLightAmbient) sum = sum + mul(Od, Lc) * double{s.ambient};
+      if (s.lightComponents & runtime::kLightAmbient) sum = sum + mul(Od, Lc) * static_cast<double>(s.ambient);
       continue;
     }
     D3 L;
@@ -58,19 +58,20 @@ D3 reference(const Show& show, const runtime::SurfaceAttributes& s, D3 P, D3 N, 
       const D3 toLight = d3(light.position) - P;
       const double d = len(toLight);
       L = toLight * (1.0 / d);
-      A = 1.0 / (double{light.attenuation1} + double{light.attenuation2} * d);
+      A = 1.0 / (static_cast<double>(light.attenuation1) + static_cast<double>(light.attenuation2) * d);
       if (light.type == LightType::kSpot) {
         const double c = dotd(L * -1.0, unit(d3(light.direction)));
-        A = c < std::cos(static_cast<double>(light.angle)) ? 0.0 : A * std::pow(c, double{light.exponent});
+        A = c < std::cos(static_cast<double>(light.angle)) ? 0.0 : A * std::pow(c, static_cast<double>(light.exponent));
       }
     }
     const double NL = dotd(N, L);
     if (NL <= 0) continue;  // the light is behind the surface
     D3 c;
-    if (s.lightComponents & runtime::kLightDiffuse) c = c + mul(Od, Lc) * (double{s.diffuse} * NL);
+    if (s.lightComponents & runtime::kLightDiffuse) c = c + mul(Od, Lc) * (static_cast<double>(s.diffuse) * NL);
     if (s.lightComponents & runtime::kLightSpecular) {
       const D3 R = N * (2 * NL) - L;
-      c = c + mul(Os, Lc) * (double{s.specular} * std::pow(std::max(dotd(E, R), 0.0), double{s.specularPower}));
+      c = c + mul(Os, Lc) * (static_cast<double>(s.specular) *
+                             std::pow(std::max(dotd(E, R), 0.0), static_cast<double>(s.specularPower)));
     }
     sum = sum + c * A;
   }
@@ -239,8 +240,8 @@ TEST_F(Illuminations, NoneAndInterpolatedColourIgnoreTheLights) {
   image = render(show, view);
   // Lower left is red, lower right green; the middle of the bottom edge mixes them.
   expectPixel(image, 2, 253, {1, 0, 0}, 6.0 / 255, "vertex colour at a corner");
-  EXPECT_GT(channel(image, 128, 253, 0), 0.3f);
-  EXPECT_GT(channel(image, 128, 253, 1), 0.3f);
+  EXPECT_GT(channel(image, 128, 253, 0), 0.3);
+  EXPECT_GT(channel(image, 128, 253, 1), 0.3);
 }
 
 TEST_F(Illuminations, LightComponentsSwitchTerms) {
@@ -306,14 +307,14 @@ TEST_F(Illuminations, FaceDistinguishingLightsTheBackWithItsOwnAttributes) {
   // The back's normal is reversed (+Z in the world, towards the light): lit with the back surface.
   const D3 back = reference(show, show.globalStyle().back, {0, 0, 0}, {0, 0, 1}, d3(view.eye));
   expectPixel(image, 128, 128, back, 2.0 / 255, "back with face distinguishing");
-  EXPECT_GT(channel(image, 128, 128, 0), 0.5f);
+  EXPECT_GT(channel(image, 128, 128, 0), 0.5);
 
   show.editGlobalStyle([](PartStyle& s) { s.render.faceDistinguishing = false; });
   image = render(show, turned);
   // Without it the back takes the front's attributes and normal (-Z: away from the light).
   const D3 front = reference(show, show.globalStyle().front, {0, 0, 0}, {0, 0, -1}, d3(view.eye));
   expectPixel(image, 128, 128, front, 2.0 / 255, "back without face distinguishing");
-  EXPECT_LT(channel(image, 128, 128, 0), 0.05f);
+  EXPECT_LT(channel(image, 128, 128, 0), 0.05);
 }
 
 TEST_F(Illuminations, FaceCullingAndHiddenSurfaceRemoval) {

@@ -70,9 +70,11 @@ runtime::Show showOf(std::shared_ptr<const runtime::Mesh> mesh);
 void lightsOff(runtime::Show& show);
 
 /// \brief Channel `c` of pixel (x, y) as 0..1.
-inline float channel(const Image& image, std::uint32_t x, std::uint32_t y, std::uint32_t c) {
-  return static_cast<float>(image.at(x, y, c)) / 255.0f;
+inline double channel(const Image& image, std::uint32_t x, std::uint32_t y, std::uint32_t c) {
+  return static_cast<double>(image.at(x, y, c)) / 255.0;
 }
+/// \brief A float widened on purpose (the tests compute references in double).
+inline double wide(float v) { return static_cast<double>(v); }
 
 /// \brief Compares with the golden image NAME under tests/render/golden ("" when it matches).
 std::string matchesGolden(const Image& image, const std::string& name);

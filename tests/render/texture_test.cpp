@@ -18,7 +18,6 @@
 namespace basalt::test {
 namespace {
 
-using runtime::AttrId;
 using runtime::PartStyle;
 using runtime::Show;
 
@@ -35,7 +34,7 @@ Image quadrantImage() {
   for (std::uint32_t y = 0; y < 64; ++y) {
     for (std::uint32_t x = 0; x < 64; ++x) {
       const bool right = x >= 32, bottom = y >= 32;
-      std::uint8_t* p = image.row(y) + x * 3;
+      std::uint8_t* p = image.row(y) + std::size_t{x} * 3;
       p[0] = static_cast<std::uint8_t>(right == bottom ? 255 : 0);
       p[1] = static_cast<std::uint8_t>(right ? 255 : 0);
       p[2] = static_cast<std::uint8_t>(bottom ? 255 : 0);
@@ -160,7 +159,7 @@ TEST_F(Textures, SphereReflectionMap) {
     for (std::uint32_t x = 0; x < 64; ++x) {
       const float dx = (static_cast<float>(x) + 0.5f) / 32.0f - 1, dy = (static_cast<float>(y) + 0.5f) / 32.0f - 1;
       const float r = std::min(std::sqrt(dx * dx + dy * dy), 1.0f);
-      std::uint8_t* p = map.row(y) + x * 3;
+      std::uint8_t* p = map.row(y) + std::size_t{x} * 3;
       const bool spot = std::hypot(dx, dy + 0.5f) < 0.15f;
       p[0] = static_cast<std::uint8_t>(spot ? 255 : 255 * (1 - r));
       p[1] = static_cast<std::uint8_t>(spot ? 0 : 255 * (1 - r));
@@ -189,7 +188,7 @@ Image smoothTexture() {
   Image image = Image::make(16, 16, 3);
   for (std::uint32_t y = 0; y < 16; ++y) {
     for (std::uint32_t x = 0; x < 16; ++x) {
-      std::uint8_t* p = image.row(y) + x * 3;
+      std::uint8_t* p = image.row(y) + std::size_t{x} * 3;
       p[0] = static_cast<std::uint8_t>(std::lround(127.5 + 127.5 * std::sin(2 * std::numbers::pi * x / 16.0)));
       p[1] = static_cast<std::uint8_t>(std::lround(127.5 + 127.5 * std::cos(2 * std::numbers::pi * y / 8.0)));
       p[2] = static_cast<std::uint8_t>(x * 16);
