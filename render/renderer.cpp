@@ -234,7 +234,9 @@ struct Renderer::Impl {
     return view;
   }
 
-  void setColorMask(bool on) { glColorMask(on && sceneMask[0], on && sceneMask[1], on && sceneMask[2], GL_TRUE); }
+  /// The scene writes colour through the view's mask and never alpha: the background leaves the
+  /// frame opaque, and snapshots stay opaque whatever transparency or antialiasing blends.
+  void setColorMask(bool on) { glColorMask(on && sceneMask[0], on && sceneMask[1], on && sceneMask[2], GL_FALSE); }
 
   // ---- Raster operations ----
 
