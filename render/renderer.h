@@ -73,7 +73,8 @@ struct RendererOptions {
 /// drawing an unchanged show allocates nothing.
 class Renderer {
  public:
-  /// \brief Compiles the shaders; needs a current OpenGL ES 3 context.
+  /// \brief Compiles the shaders; needs a current OpenGL ES 3 context, with the framebuffer it
+  /// will draw into bound (its stencil buffer, if any, is what the fake shadow uses).
   static Result<std::unique_ptr<Renderer>> create(const RendererOptions& options = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;

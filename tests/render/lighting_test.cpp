@@ -126,61 +126,75 @@ Light makeLight(LightType type) {
   return l;
 }
 
-class Lighting : public RenderTest, public ::testing::WithParamInterface<LightType> {};
-
-TEST_P(Lighting, FlatQuadPerPixelFollowsTheEquations) {
-  Show show = showOf(makeQuad(1.0f, 0.0f, 1));
-  lightsOff(show);
-  show.lights()[0] = makeLight(GetParam());
-  setMaterial(show, Illumination::kPerPixel);
-  const runtime::ViewTransforms view = testCamera();
-  const Image image = render(show, view);
-  int lit = 0;
-  for (std::uint32_t y = 16; y < kRenderSize; y += 28) {
-    for (std::uint32_t x = 16; x < kRenderSize; x += 28) {
-      const D3 P = d3(pixelOnPlane(view, x, y, 0));
-      const D3 expected = reference(show, show.globalStyle().front, P, {0, 0, 1}, d3(view.eye));
-      if (expected.x + expected.y + expected.z > 0.05) ++lit;
-      expectPixel(image, x, y, expected, 2.0 / 255, "quad");
-    }
+constexpr LightType kLightTypes[] = {LightType::kAmbient, LightType::kDirectional, LightType::kPositional,
+                                     LightType::kSpot};
+const char* typeName(LightType t) {
+  switch (t) {
+    case LightType::kAmbient: return "ambient light";
+    case LightType::kDirectional: return "directional light";
+    case LightType::kPositional: return "positional light";
+    case LightType::kSpot: return "spot light";
   }
-  EXPECT_GT(lit, 10) << "the light should reach most of the quad";
+  return "?";
 }
 
-TEST_P(Lighting, SpherePerPixelFollowsTheEquations) {
-  Show show = showOf(makeSphere(1.0f, 96, 192));
-  lightsOff(show);
-  show.lights()[0] = makeLight(GetParam());
-  setMaterial(show, Illumination::kPerPixel);
-  const runtime::ViewTransforms view = testCamera(3.0f, 1.2f);
-  const Image image = render(show, view);
-  int checked = 0;
-  for (std::uint32_t y = 20; y < kRenderSize; y += 18) {
-    for (std::uint32_t x = 20; x < kRenderSize; x += 18) {
-      Vec3 hit;
-      if (!pixelOnSphere(view, x, y, {0, 0, 0}, 1.0f, hit)) continue;
-      if (hit.z < 0.35f) continue;  // near the outline the tessellation and the sphere part ways
-      const D3 P = d3(hit);
-      const D3 expected = reference(show, show.globalStyle().front, P, unit(P), d3(view.eye));
-      expectPixel(image, x, y, expected, 3.0 / 255, "sphere");
-      ++checked;
+class Lighting : public RenderTest {
+ protected:
+  void checkQuad(LightType type) {
+    Show show = showOf(makeQuad(1.0f, 0.0f, 1));
+    lightsOff(show);
+    show.lights()[0] = makeLight(type);
+    setMaterial(show, Illumination::kPerPixel);
+    const runtime::ViewTransforms view = testCamera();
+    const Image image = render(show, view);
+    int lit = 0;
+    for (std::uint32_t y = 16; y < kRenderSize; y += 28) {
+      for (std::uint32_t x = 16; x < kRenderSize; x += 28) {
+        const D3 P = d3(pixelOnPlane(view, x, y, 0));
+        const D3 expected = reference(show, show.globalStyle().front, P, {0, 0, 1}, d3(view.eye));
+        if (expected.x + expected.y + expected.z > 0.05) ++lit;
+        expectPixel(image, x, y, expected, 2.0 / 255, "quad");
+      }
     }
+    EXPECT_GT(lit, 10) << "the light should reach most of the quad";
   }
-  EXPECT_GT(checked, 60);
+
+  void checkSphere(LightType type) {
+    Show show = showOf(makeSphere(1.0f, 96, 192));
+    lightsOff(show);
+    show.lights()[0] = makeLight(type);
+    setMaterial(show, Illumination::kPerPixel);
+    const runtime::ViewTransforms view = testCamera(3.0f, 1.2f);
+    const Image image = render(show, view);
+    int checked = 0;
+    for (std::uint32_t y = 20; y < kRenderSize; y += 18) {
+      for (std::uint32_t x = 20; x < kRenderSize; x += 18) {
+        Vec3 hit;
+        if (!pixelOnSphere(view, x, y, {0, 0, 0}, 1.0f, hit)) continue;
+        if (hit.z < 0.35f) continue;  // near the outline the tessellation and the sphere part ways
+        const D3 P = d3(hit);
+        const D3 expected = reference(show, show.globalStyle().front, P, unit(P), d3(view.eye));
+        expectPixel(image, x, y, expected, 3.0 / 255, "sphere");
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 60);
+  }
+};
+
+TEST_F(Lighting, FlatQuadPerPixelFollowsTheEquations) {
+  for (const LightType type : kLightTypes) {
+    SCOPED_TRACE(typeName(type));
+    checkQuad(type);
+  }
 }
 
-INSTANTIATE_TEST_SUITE_P(EachLightType, Lighting,
-                         ::testing::Values(LightType::kAmbient, LightType::kDirectional, LightType::kPositional,
-                                           LightType::kSpot),
-                         [](const ::testing::TestParamInfo<LightType>& param) {
-                           switch (param.param) {
-                             case LightType::kAmbient: return std::string("Ambient");
-                             case LightType::kDirectional: return std::string("Directional");
-                             case LightType::kPositional: return std::string("Positional");
-                             case LightType::kSpot: return std::string("Spot");
-                           }
-                           return std::string("Unknown");
-                         });
+TEST_F(Lighting, SpherePerPixelFollowsTheEquations) {
+  for (const LightType type : kLightTypes) {
+    SCOPED_TRACE(typeName(type));
+    checkSphere(type);
+  }
+}
 
 class Illuminations : public RenderTest {};
 
