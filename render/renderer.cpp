@@ -327,8 +327,6 @@ struct Renderer::Impl {
 
   // ---- Surfaces ----
 
-  enum class Faces : std::uint8_t { kAll, kBackOnly, kFrontOnly };
-
   struct SurfaceLook {
     bool screenDoor = false;
     bool blendToBackground = false;

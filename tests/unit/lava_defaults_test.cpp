@@ -259,6 +259,20 @@ TEST(ViewSettings, ObjectScaleAndCentre) {
   EXPECT_FLOAT_EQ(ortho.projection(3, 2), 0.0f) << "perspective 0 is orthographic";
 }
 
+TEST(ViewSettings, ViewScaleAndZClipScale) {
+  Show show = Show::makeDefault();
+  show.view().viewScale = 2.0f;  // "Allows the overall image to be scaled"
+  const ViewTransforms t = computeView(show, 1.0f);
+  const Vec3 edge = (t.projection * t.view).transformPoint({0.5f, 0, 0});
+  EXPECT_NEAR(edge.x, 1.0f, 1e-5f) << "twice the scale: half a window unit reaches the edge";
+  show.view().zClipScale = 0.5f;  // near and far planes half a unit either side of the centre
+  const ViewTransforms z = computeView(show, 1.0f);
+  const Vec3 inside = (z.projection * z.view).transformPoint({0, 0, 0.45f});
+  const Vec3 outside = (z.projection * z.view).transformPoint({0, 0, 0.55f});
+  EXPECT_LT(std::fabs(inside.z), 1.0f);
+  EXPECT_GT(std::fabs(outside.z), 1.0f) << "beyond the z-clip scale is clipped";
+}
+
 // ---- Floor and shadow ----
 
 TEST(Floor, TouchesTheObjectAndTheShadowLiesOnIt) {
