@@ -7,25 +7,50 @@
 
 namespace basalt::test {
 
-RenderContext& renderContext() {
-  static RenderContext context = [] {
-    RenderContext c;
-    auto output = render::createHeadlessOutput({kRenderSize, kRenderSize});
-    if (!output) {
-      c.unavailable = output.error().describe();
-      return c;
-    }
-    c.output = std::move(*output);
-    auto renderer = render::Renderer::create();
-    if (!renderer) {
-      c.unavailable = "the renderer does not start: " + renderer.error().describe();
-      c.output.reset();
-      return c;
-    }
-    c.renderer = std::move(*renderer);
-    return c;
-  }();
+namespace {
+
+std::unique_ptr<RenderContext>& contextSlot() {
+  static std::unique_ptr<RenderContext> context;
   return context;
+}
+
+/// Releases the GL objects, the context and the EGL display when the tests are done, before
+/// main() returns: the driver's threads are gone by the time LeakSanitizer stops the world.
+class ReleaseRenderContext final : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    if (auto& c = contextSlot()) {
+      c->renderer.reset();
+      c->output.reset();
+      c.reset();
+    }
+  }
+};
+
+[[maybe_unused]] ::testing::Environment* const kReleaseRenderContext =
+    ::testing::AddGlobalTestEnvironment(new ReleaseRenderContext);
+
+}  // namespace
+
+RenderContext& renderContext() {
+  auto& slot = contextSlot();
+  if (slot) return *slot;
+  slot = std::make_unique<RenderContext>();
+  RenderContext& c = *slot;
+  auto output = render::createHeadlessOutput({kRenderSize, kRenderSize});
+  if (!output) {
+    c.unavailable = output.error().describe();
+    return c;
+  }
+  c.output = std::move(*output);
+  auto renderer = render::Renderer::create();
+  if (!renderer) {
+    c.unavailable = "the renderer does not start: " + renderer.error().describe();
+    c.output.reset();
+    return c;
+  }
+  c.renderer = std::move(*renderer);
+  return c;
 }
 
 void RenderTest::SetUp() {
