@@ -149,6 +149,43 @@ TEST_F(Goldens, WideLinesEndsAndJoins) {
   expectGolden(image, "lines_wide");
 }
 
+TEST_F(Goldens, VertexColoursOnLinesAndMarkers) {
+  // A wide line from red to blue and a point at each end: with the vertex colour selector the
+  // line takes its first vertex's colour, or blends along when colour interpolation is on; the
+  // markers take their vertices' colours.
+  auto line = makePolyline({{-0.8f, 0, 0}, {0.8f, 0, 0}}, "line");
+  line->colors = {{1, 0, 0, 1}, {0, 0, 1, 1}};
+  auto points = makePoints({{-0.8f, 0.5f, 0}, {0.8f, 0.5f, 0}}, "points");
+  points->colors = {{0, 1, 0, 1}, {1, 1, 0, 1}};
+  Show show = showOf(combine({line, points}));
+  show.editGlobalStyle([](PartStyle& s) {
+    s.lines.width = 6;
+    s.lines.antialiasing = runtime::Antialiasing::kConstantBackground;  // the wide-line path
+    s.lines.colorSelector = runtime::ColorSelector::kVertex;
+    s.markers.type = runtime::MarkerType::kSquare;
+    s.markers.scaleFactor = 15;
+    s.markers.colorSelector = runtime::ColorSelector::kVertex;
+  });
+  const runtime::ViewTransforms view = testCamera();
+  auto at = [&](const Image& image, float x, float y, std::uint32_t c) {
+    const Vec2 p = worldToPixel(view, {x, y, 0});
+    return image.at(static_cast<std::uint32_t>(std::lround(p.x)), static_cast<std::uint32_t>(std::lround(p.y)), c);
+  };
+  Image image = render(show, view);
+  EXPECT_GT(at(image, 0.6f, 0, 0), 240) << "flat: the first vertex's red all along";
+  EXPECT_LT(at(image, 0.6f, 0, 2), 15);
+  show.editGlobalStyle([](PartStyle& s) { s.lines.colorInterpolation = true; });
+  image = render(show, view);
+  EXPECT_NEAR(at(image, 0, 0, 0), 128, 12) << "interpolated: half way between red and blue";
+  EXPECT_NEAR(at(image, 0, 0, 2), 128, 12);
+  EXPECT_GT(at(image, 0.6f, 0, 2), 200);
+  // The square markers' outlines (corners on the marker's circle: 5 pixels from the vertex) in their colours.
+  const Vec2 left = worldToPixel(view, {-0.8f, 0.5f, 0});
+  EXPECT_GT(
+      image.at(static_cast<std::uint32_t>(std::lround(left.x)) + 5, static_cast<std::uint32_t>(std::lround(left.y)), 1),
+      200);
+}
+
 TEST_F(Goldens, StipplePatterns) {
   // The twelve stipple patterns over a red square: stipple lets it through, opaque stipple (the
   // right column) paints the background colour instead.
