@@ -26,8 +26,7 @@ Result<void> FrameLoop::renderFrame(const FrameContext& context) {
   }
   if (auto r = output_.beginFrame(); !r) return r;
   const render::Size size = output_.size();
-  const float aspect = static_cast<float>(size.width) / static_cast<float>(size.height);
-  renderer_.draw(show_, runtime::computeView(show_, aspect), size);
+  renderer_.drawShow(show_, {0, 0, size.width, size.height});
   for (FrameParticipant* p : participants_) {
     if (auto r = p->afterDraw(context, output_); !r) return r;
   }
@@ -72,6 +71,8 @@ Result<FrameLoopStats> FrameLoop::run() {
     if (frame == 0) stats.firstFrameSeconds = toSeconds(wall.now() - wallStart);
     stats.frames = frame + 1;
     stats.showTime = due - start;
+    // LAVA's performance meter: this frame's counts, rates over real time.
+    show_.performance().recordFrame(renderer_.takeFrameCounts(), wall.now());
     show_.advanceFrame();
     for (FrameParticipant* p : participants_) p->afterPresent(context);
     if (last) break;

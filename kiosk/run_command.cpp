@@ -176,6 +176,18 @@ int runShow(const RunOptions& options) {
 
   auto loop = runtime::EventLoop::create(clock);
   if (!loop) return failWith(loop.error(), "cannot start the event loop");
+  // Watch SIGINT/SIGTERM before the slow set-up (EGL, shaders): a signal that comes meanwhile
+  // stays pending on the signalfd and stops the loop at its first frame, instead of killing us.
+  FrameLoop* running = nullptr;
+  bool stopEarly = false;
+  auto stopOnSignal = (*loop)->watchSignals({SIGINT, SIGTERM}, [&running, &stopEarly](int) {
+    if (running) {
+      running->requestStop();
+    } else {
+      stopEarly = true;
+    }
+  });
+  if (!stopOnSignal) return failWith(stopOnSignal.error(), "cannot watch for signals");
 
   // Only the headless output exists in this build; KMS and window outputs plug in here.
   auto output = render::createHeadlessOutput({options.width, options.height});
@@ -187,8 +199,8 @@ int runShow(const RunOptions& options) {
   FrameLoop frameLoop({options.fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output,
                       **renderer);
 
-  auto stopOnSignal = (*loop)->watchSignals({SIGINT, SIGTERM}, [&frameLoop](int) { frameLoop.requestStop(); });
-  if (!stopOnSignal) return failWith(stopOnSignal.error(), "cannot watch for signals");
+  running = &frameLoop;
+  if (stopEarly) frameLoop.requestStop();
 
   Image snapshot;
   bool snapshotWritten = false;
