@@ -32,6 +32,7 @@ Mat4 Show::worldTransform(NodeId id) const {
 
 void Show::clear() {
   nodes_.clear();
+  terrains_.clear();
   parts_.clear();
   resolved_.clear();
   resolvedAt_.clear();
@@ -52,6 +53,26 @@ Bounds Show::sceneBounds() const {
     }
   }
   return b;
+}
+
+NodeId Show::addTerrain(SceneNode node, std::shared_ptr<const HeightField> heights) {
+  const NodeId id = addNode(std::move(node));
+  if (heights) terrains_.push_back(std::move(heights));
+  return id;
+}
+
+std::optional<float> Show::terrainHeightAt(float x, float z) const {
+  for (const auto& t : terrains_) {
+    if (auto h = t->heightAt(x, z)) return h;
+  }
+  return std::nullopt;
+}
+
+std::optional<NodeId> Show::findNode(std::string_view name) const {
+  for (NodeId i = 0; i < nodes_.size(); ++i) {
+    if (nodes_[i].name == name) return i;
+  }
+  return std::nullopt;
 }
 
 PartId Show::internPart(const std::string& name) {
@@ -116,6 +137,7 @@ void Show::resetAttributes() {
   backgroundKind_ = BackgroundKind::kColor;
   backgroundImage_.clear();
   earthSky_ = {};
+  viewer_ = {};
 }
 
 namespace {
@@ -246,6 +268,8 @@ std::shared_ptr<const Mesh> makeColorCube() {
     for (std::uint32_t i : {0u, 1u, 1u, 2u, 2u, 3u, 3u, 0u}) mesh->edges.push_back(base + i);
     part.edgeIndexCount = 8;
     part.facetCount = 1;
+    part.firstFacet = static_cast<std::uint32_t>(mesh->facetSizes.size());
+    mesh->facetSizes.push_back(4);
     mesh->parts.push_back(std::move(part));
   }
   return mesh;

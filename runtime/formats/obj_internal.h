@@ -1,0 +1,18 @@
+#pragma once
+
+/// \file
+/// \brief Entry points of the model readers inside runtime/formats (not for other folders).
+
+#include <filesystem>
+#include <string>
+
+#include "runtime/formats/model.h"
+
+namespace basalt::formats {
+
+/// \brief Reads OBJ text (already decoded), with material libraries from the file's folder.
+Result<LoadedModel> readObjFile(std::string_view text, const std::filesystem::path& path, const LoadOptions& options);
+/// \brief Reads OFF file bytes.
+Result<LoadedModel> readOffFile(std::string bytes, const std::filesystem::path& path, const LoadOptions& options);
+
+}  // namespace basalt::formats
