@@ -308,7 +308,6 @@ class ObjParser {
         if (k.v < headOf_.size()) headOf_[k.v] = kNone;
       }
     }
-    currentGroup_ = kNone;
   }
 
   std::string restOfLine() const { return normaliseName(line_.substr(argsAt_, argsEnd_ - argsAt_)); }
@@ -327,6 +326,7 @@ class ObjParser {
     o.object.line = lineNumber_;
     if (o.object.name.empty()) o.object.name = fmt::format("{}.{}", defaultObjectName_, objects_.size());
     beginObject();
+    currentGroup_ = kNone;  // a new object's faces are its own part until a 'g
     placed_ = false;
     return {};
   }

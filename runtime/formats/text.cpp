@@ -409,7 +409,13 @@ ResolvedPath resolveReferencedFile(std::string_view name, const std::filesystem:
       if (!named.is_absolute() && isRegularFile(folder / named)) return {(folder / named).lexically_normal(), true};
       if (isRegularFile(folder / leaf)) return {(folder / leaf).lexically_normal(), true};
     }
-    if (auto match = caseInsensitiveMatch(base, leaf.string())) return {match->lexically_normal(), true};
+    // Names written on Windows often differ in case from the files: look in the named folder,
+    // then beside the referring file.
+    const std::filesystem::path namedFolder = direct.parent_path();
+    if (auto match = caseInsensitiveMatch(namedFolder, leaf.string())) return {match->lexically_normal(), true};
+    if (namedFolder != base.lexically_normal()) {
+      if (auto match = caseInsensitiveMatch(base, leaf.string())) return {match->lexically_normal(), true};
+    }
   }
   return {direct, false};
 }
