@@ -207,7 +207,12 @@ class ObjParser {
       }
       if (n >= 6) {
         // "v x y z r g b" (MeshLab, ZBrush, Blender) and "v x y z r g b a": vertex colours.
-        setColour(static_cast<std::uint32_t>(positions_.size()), {v[3], v[4], v[5], n == 7 ? v[6] : 1.0f});
+        const Vec4 c{v[3], v[4], v[5], n == 7 ? v[6] : 1.0f};
+        if (std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w)) {
+          setColour(static_cast<std::uint32_t>(positions_.size()), c);
+        } else {
+          d_.warn(lineNumber_, col(argsAt_ + 1), "the vertex colour is not finite numbers; the vertex is white");
+        }
       }
     } else if (n >= 0) {
       d_.warn(lineNumber_, col(argsAt_ + 1),

@@ -734,7 +734,19 @@ namespace {
 
 int byte(float c) { return static_cast<int>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f)); }
 
-std::string colourText(const runtime::Color3& c) { return fmt::format("{},{},{}", byte(c.r), byte(c.g), byte(c.b)); }
+bool exactByte(float c) {
+  const float scaled = c * 255.0f;
+  return scaled >= 0 && scaled <= 255 && static_cast<float>(std::lround(scaled)) / 255.0f == c;
+}
+
+/// Colours as the thesis writes them, 0..255; a colour that no byte holds exactly is written as
+/// 0..1 fractions (the reader tells them apart by the decimal point), so nothing is lost.
+std::string colourText(const runtime::Color3& c) {
+  if (exactByte(c.r) && exactByte(c.g) && exactByte(c.b)) {
+    return fmt::format("{},{},{}", byte(c.r), byte(c.g), byte(c.b));
+  }
+  return fmt::format("{},{},{}", std::clamp(c.r, 0.0f, 1.0f), std::clamp(c.g, 0.0f, 1.0f), std::clamp(c.b, 0.0f, 1.0f));
+}
 
 std::string vecText(const Vec3& v) { return fmt::format("{},{},{}", v.x, v.y, v.z); }
 
