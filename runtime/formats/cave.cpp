@@ -27,6 +27,21 @@ Result<CaveParse> parseCaveText(std::string_view text, const std::string& name, 
   while (auto raw = lines.next()) {
     std::string_view line = *raw;
     if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    // "model" takes the rest of the line as a file name, brackets and all ("model[x.obj]" and
+    // "model x.obj" are both the thesis' form).
+    const std::string_view content = trim(line);
+    const std::string_view firstWord = content.substr(0, std::min(content.find_first_of(" \t["), content.size()));
+    if (lowerAscii(firstWord) == "model") {
+      const std::string where = d.where(lines.number(), col(static_cast<std::size_t>(content.data() - line.data())));
+      std::string_view rest = trim(content.substr(firstWord.size()));
+      if (rest.size() >= 2 && rest.front() == '[' && rest.back() == ']') rest = trim(rest.substr(1, rest.size() - 2));
+      if (rest.empty()) return parseError(where, "'model' needs the name of the cave geometry's OBJ file");
+      out.settings.model = std::string(rest);
+      out.modelGiven = true;
+      out.modelLine = lines.number();
+      modelKnown = true;
+      continue;
+    }
     std::size_t errorAt = 0;
     if (!splitStatementItems(line, items, errorAt)) {
       return parseError(d.where(lines.number(), col(errorAt)), "'[' is not closed by ']'");
@@ -35,16 +50,6 @@ Result<CaveParse> parseCaveText(std::string_view text, const std::string& name, 
     const StatementItem& key = items[0];
     const std::string keyword = lowerAscii(key.name);
     const std::string where = d.where(lines.number(), col(key.offset));
-    if (keyword == "model") {
-      std::string_view rest = trim(line.substr(key.offset + key.name.size()));
-      if (key.bracketed && key.args.size() == 1) rest = key.args[0];
-      if (rest.empty()) return parseError(where, "'model' needs the name of the cave geometry's OBJ file");
-      out.settings.model = std::string(rest);
-      out.modelGiven = true;
-      out.modelLine = lines.number();
-      modelKnown = true;
-      continue;
-    }
     // Every other statement takes one number: "facet[3]" or "facet 3".
     std::string_view value;
     std::size_t valueAt = key.offset;
@@ -284,7 +289,11 @@ Result<LoadedCave> loadCave(const std::filesystem::path& path, const LoadedCave*
 
 std::string formatCave(const CaveSettings& s) {
   std::string out = "# Cave written by Basalt (thesis appendix C.1)\n";
-  if (!s.model.empty()) out += fmt::format("model {}\n", s.model);
+  if (!s.model.empty()) {
+    // A name that is itself in brackets keeps them inside the thesis' bracket form.
+    const bool bracketed = s.model.front() == '[' && s.model.back() == ']';
+    out += bracketed ? fmt::format("model[{}]\n", s.model) : fmt::format("model {}\n", s.model);
+  }
   out += fmt::format("facet[{}]\nside[{}]\nXscale[{}]\nYscale[{}]\nXskew[{}]\nYskew[{}]\n", s.facet, s.side, s.xScale,
                      s.yScale, s.xSkew, s.ySkew);
   // Zrotation may only follow a model.

@@ -123,8 +123,8 @@ Result<LoadedModel> loadModel(const std::filesystem::path& path, const LoadOptio
     decoding.warn(0, 0, "the file is named .obj but holds OFF; it is read as OFF");
     format = Sniffed::kOff;
   }
-  Result<LoadedModel> model =
-      format == Sniffed::kOff ? readOffFile(std::move(*text), path, options) : readObjFile(*text, path, options);
+  Result<LoadedModel> model = format == Sniffed::kOff ? readOffFile(std::move(*text), path, options)
+                                                      : readObjFile(std::move(*text), path, options);
   if (!model) return model;
   std::vector<Diagnostic> first = decoding.finish();
   if (!first.empty()) model->warnings.insert(model->warnings.begin(), first.begin(), first.end());

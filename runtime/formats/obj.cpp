@@ -72,6 +72,12 @@ class ObjParser {
         readLibraries_(readLibraries),
         d_(name_, options.limits.maxWarnings, options.logWarnings) {}
 
+  /// Parses text it owns, and frees it before building the meshes.
+  Result<LoadedModel> parseOwned(std::string text) {
+    owned_ = std::move(text);
+    return parseText(owned_);
+  }
+
   Result<LoadedModel> parse(std::string_view bytesOrText, bool alreadyText) {
     std::string decoded;
     std::string_view text = bytesOrText;
@@ -92,12 +98,14 @@ class ObjParser {
     defaultObjectName_ = stemPath.stem().string();
     if (defaultObjectName_.empty()) defaultObjectName_ = "object";
     groupIds_.reserve(16);
-    LineReader lines(text);
+    LineReader lines(text, LineReader::Continuation::kObjData);
     while (auto raw = lines.next()) {
       line_ = *raw;
       lineNumber_ = lines.number();
       if (auto r = statement(); !r) return std::unexpected(r.error());
     }
+    line_ = {};
+    std::string().swap(owned_);  // the text is parsed: its memory goes before the meshes are built
     return finish();
   }
 
@@ -832,21 +840,34 @@ class ObjParser {
     }
     bool anyInstance = false;
     for (const ObjectBuild& o : objects_) anyInstance = anyInstance || !o.object.instanceOf.empty();
-    if (!anyGeometry && !anyInstance) {
+    // Objects without geometry still mean something when they place or parent others (an
+    // Extended OBJ hierarchy whose geometry comes from other files).
+    bool anyTransformObject = false;
+    for (const ObjectBuild& o : objects_) {
+      const ModelObject& m = o.object;
+      anyTransformObject = anyTransformObject || !m.parent.empty() || m.position != Vec3{0, 0, 0} ||
+                           m.rotation != Vec3{0, 0, 0} || m.scale != Vec3{1, 1, 1} || !m.colorMap.empty() ||
+                           !m.reflectionMap.empty() || !m.bumpMap.empty();
+    }
+    if (!anyGeometry && !anyInstance && !anyTransformObject) {
       if (firstSkip_) {
         return fail(Errc::kParse, firstSkip_->message + " (nothing else in the file could be drawn)",
                     firstSkip_->where);
       }
-      bool anyPlacedObject = false;
-      for (const ObjectBuild& o : objects_) anyPlacedObject = anyPlacedObject || o.explicitObject;
-      if (!anyPlacedObject || positions_.empty()) {
+      {
         return fail(Errc::kParse,
                     positions_.empty() ? "the file has no vertices, faces, lines or points; is it an OBJ file?"
                                        : "none of the file's vertices could be read",
                     name_);
       }
     }
-    for (ObjectBuild& o : objects_) {
+    std::size_t lastWithGeometry = objects_.size();
+    for (std::size_t i = 0; i < objects_.size(); ++i) {
+      if (objects_[i].hasElements && objects_[i].object.instanceOf.empty()) lastWithGeometry = i;
+    }
+    for (std::size_t i = 0; i < objects_.size(); ++i) {
+      ObjectBuild& o = objects_[i];
+      lastMesh_ = i == lastWithGeometry;
       if (!o.hasElements && !o.explicitObject && o.object.parent.empty() && o.object.instanceOf.empty()) continue;
       if (o.hasElements && !o.object.instanceOf.empty()) {
         d_.warn(o.instanceLine, 0,
@@ -858,6 +879,7 @@ class ObjParser {
       if (o.hasElements) o.object.mesh = buildMesh(o);
       model.objects.push_back(std::move(o.object));
     }
+    objects_.clear();
     model.warnings = d_.finish();
     for (Diagnostic& w : libraryWarnings_) model.warnings.push_back(std::move(w));
     return model;
@@ -953,8 +975,14 @@ class ObjParser {
     }
     const std::size_t count = o.vertices.size();
     const auto source = [&](std::size_t i) -> const VertexKey& { return o.vertices[order.empty() ? i : order[i]]; };
+    // The last mesh built frees each raw array as soon as it has taken what it needs.
+    const auto done = [this](auto& raw) {
+      if (lastMesh_) std::remove_reference_t<decltype(raw)>().swap(raw);
+    };
     m.positions.resize(count);
     for (std::size_t i = 0; i < count; ++i) m.positions[i] = positions_[source(i).v];
+    done(positions_);
+    done(headOf_);
     if (o.hasTexcoords) {
       m.texcoords.resize(count);
       for (std::size_t i = 0; i < count; ++i) {
@@ -962,6 +990,7 @@ class ObjParser {
         m.texcoords[i] = vt == kNone ? Vec2{0, 0} : texcoords_[vt];
       }
     }
+    done(texcoords_);
     if (o.hasNormals) {
       m.normals.resize(count);
       for (std::size_t i = 0; i < count; ++i) {
@@ -977,6 +1006,8 @@ class ObjParser {
         }
       }
     }
+    done(normals_);
+    done(accumulators_);
     if (!colours_.empty()) {
       m.colors.resize(count);
       for (std::size_t i = 0; i < count; ++i) {
@@ -992,6 +1023,7 @@ class ObjParser {
   }
 
   std::string name_;
+  std::string owned_;  // the file's text when the parser owns it
   std::filesystem::path folder_;
   const LoadOptions& options_;
   const Limits& limits_;
@@ -1014,6 +1046,7 @@ class ObjParser {
   std::vector<ObjectBuild> objects_;
   std::string defaultObjectName_;
   bool placed_ = false;
+  bool lastMesh_ = false;
   bool extended_ = false;
   std::optional<Diagnostic> firstSkip_;
   std::uint32_t attributeWarnedLine_ = 0;
@@ -1046,9 +1079,9 @@ Result<LoadedModel> parseObjText(std::string_view text, const std::string& name,
   return parser.parse(text, false);
 }
 
-Result<LoadedModel> readObjFile(std::string_view text, const std::filesystem::path& path, const LoadOptions& options) {
+Result<LoadedModel> readObjFile(std::string text, const std::filesystem::path& path, const LoadOptions& options) {
   ObjParser parser(path.string(), path.parent_path(), options, true);
-  auto model = parser.parse(text, true);
+  auto model = parser.parseOwned(std::move(text));
   if (model) model->path = path;
   return model;
 }

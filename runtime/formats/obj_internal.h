@@ -10,8 +10,9 @@
 
 namespace basalt::formats {
 
-/// \brief Reads OBJ text (already decoded), with material libraries from the file's folder.
-Result<LoadedModel> readObjFile(std::string_view text, const std::filesystem::path& path, const LoadOptions& options);
+/// \brief Reads OBJ text (already decoded), with material libraries from the file's folder. The
+/// text is released as soon as it is parsed, before the meshes are built (a lower peak).
+Result<LoadedModel> readObjFile(std::string text, const std::filesystem::path& path, const LoadOptions& options);
 /// \brief Reads OFF file bytes.
 Result<LoadedModel> readOffFile(std::string bytes, const std::filesystem::path& path, const LoadOptions& options);
 

@@ -327,6 +327,25 @@ bool splitStatementItems(std::string_view line, std::vector<StatementItem>& item
   return true;
 }
 
+namespace {
+
+/// True when the line is an OBJ statement whose arguments are numbers or vertex references.
+bool isObjDataStatement(std::string_view line) {
+  std::size_t i = 0;
+  while (i < line.size() && isBlank(line[i])) ++i;
+  std::size_t end = i;
+  while (end < line.size() && !isBlank(line[end])) ++end;
+  const std::string_view key = line.substr(i, end - i);
+  static constexpr std::string_view kData[] = {"v",  "vt",   "vn",  "vc",   "vp",  "f",   "fo", "l",
+                                               "p",  "curv", "curv2", "surf", "parm", "trim", "hole"};
+  for (std::string_view k : kData) {
+    if (k == key) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 // ---- Lines ------------------------------------------------------------------------------------
 
 std::optional<std::string_view> LineReader::next() {
@@ -351,7 +370,8 @@ std::optional<std::string_view> LineReader::next() {
     ++nextNumber_;
     std::string_view content = line;
     while (!content.empty() && isBlank(content.back())) content.remove_suffix(1);
-    const bool continues = !content.empty() && content.back() == '\\' && pos_ < text_.size();
+    const bool continues = continuation_ == Continuation::kObjData && !content.empty() && content.back() == '\\' &&
+                           pos_ < text_.size() && isObjDataStatement(continued ? std::string_view(joined_) : line);
     if (!continues && !continued) return line;
     if (continues) content.remove_suffix(1);
     joined_.append(continues ? content : line);

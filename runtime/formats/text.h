@@ -107,11 +107,16 @@ std::string normaliseName(std::string_view text);
 /// \brief ASCII lower case.
 std::string lowerAscii(std::string_view text);
 
-/// \brief Walks the lines of a text: "\n", "\r\n" and a lone "\r" end a line, the last line
-/// needs no end, and a line ending in a backslash continues on the next (OBJ's continuation).
+/// \brief Walks the lines of a text: "\n", "\r\n" and a lone "\r" end a line, and the last line
+/// needs no end.
 class LineReader {
  public:
-  explicit LineReader(std::string_view text) : text_(text) {}
+  /// \brief kObjData: a vertex or element statement (v, vt, vn, vc, f, l, p, ...) ending in a
+  /// backslash continues on the next line, as the OBJ specification allows. Names and file
+  /// names never continue, so that a name ending in a backslash reads back as written.
+  enum class Continuation : std::uint8_t { kNone, kObjData };
+  explicit LineReader(std::string_view text, Continuation continuation = Continuation::kNone)
+      : text_(text), continuation_(continuation) {}
   /// \brief The next line without its end, or nothing at the end of the text. `number()` is its
   /// 1-based line number (the first line of a continued line).
   std::optional<std::string_view> next();
@@ -124,6 +129,7 @@ class LineReader {
 
  private:
   std::string_view text_;
+  Continuation continuation_;
   std::size_t pos_ = 0;
   std::uint32_t number_ = 0;
   std::uint32_t nextNumber_ = 1;
