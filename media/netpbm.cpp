@@ -128,18 +128,19 @@ Result<void> readPamHeader(Reader& r, Header& h) {
       return true;
     };
     if (key == "WIDTH") {
-      if (!(haveW = parse(h.width, kMaxSide)))
-        return fail(Errc::kParse, fmt::format("PAM WIDTH '{}' is not 1 to {}", value, kMaxSide));
+      haveW = parse(h.width, kMaxSide);
+      if (!haveW) return fail(Errc::kParse, fmt::format("PAM WIDTH '{}' is not 1 to {}", value, kMaxSide));
     } else if (key == "HEIGHT") {
-      if (!(haveH = parse(h.height, kMaxSide)))
-        return fail(Errc::kParse, fmt::format("PAM HEIGHT '{}' is not 1 to {}", value, kMaxSide));
+      haveH = parse(h.height, kMaxSide);
+      if (!haveH) return fail(Errc::kParse, fmt::format("PAM HEIGHT '{}' is not 1 to {}", value, kMaxSide));
     } else if (key == "DEPTH") {
-      if (!(haveD = parse(h.depth, 4))) {
+      haveD = parse(h.depth, 4);
+      if (!haveD) {
         return fail(Errc::kUnsupported, fmt::format("PAM DEPTH '{}' is not supported (1 to 4 channels)", value));
       }
     } else if (key == "MAXVAL") {
-      if (!(haveM = parse(h.maxval, 65535)))
-        return fail(Errc::kParse, fmt::format("PAM MAXVAL '{}' is not 1 to 65535", value));
+      haveM = parse(h.maxval, 65535);
+      if (!haveM) return fail(Errc::kParse, fmt::format("PAM MAXVAL '{}' is not 1 to 65535", value));
     } else if (key == "TUPLTYPE") {
       tupleType += value;
     } else {

@@ -125,7 +125,7 @@ struct Writer {
         for (std::uint32_t f = 0; f < part.facetCount && facet < m.facetSizes.size(); ++f, ++facet) {
           out += 'f';
           const std::uint32_t n = m.facetSizes[facet];
-          for (std::uint32_t k = 0; k < n && edge + 2 * k < m.edges.size(); ++k) corner(m.edges[edge + 2 * k], true);
+          for (std::size_t k = 0; k < n && edge + 2 * k < m.edges.size(); ++k) corner(m.edges[edge + 2 * k], true);
           edge += 2 * std::size_t{n};
           out += '\n';
         }

@@ -35,13 +35,14 @@ std::vector<Point2> projectCounterClockwise(std::span<const Vec3> corners, const
   const float ax = std::fabs(normal.x), ay = std::fabs(normal.y), az = std::fabs(normal.z);
   std::vector<Point2> p(corners.size());
   for (std::size_t i = 0; i < corners.size(); ++i) {
-    const Vec3& c = corners[i];
+    const double x = static_cast<double>(corners[i].x), y = static_cast<double>(corners[i].y),
+                 z = static_cast<double>(corners[i].z);
     if (az >= ax && az >= ay) {
-      p[i] = {c.x, normal.z >= 0 ? c.y : -c.y};
+      p[i] = {x, normal.z >= 0 ? y : -y};
     } else if (ax >= ay) {
-      p[i] = {c.y, normal.x >= 0 ? c.z : -c.z};
+      p[i] = {y, normal.x >= 0 ? z : -z};
     } else {
-      p[i] = {c.z, normal.y >= 0 ? c.x : -c.x};
+      p[i] = {z, normal.y >= 0 ? x : -x};
     }
   }
   return p;

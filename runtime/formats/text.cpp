@@ -198,8 +198,7 @@ Result<std::string> decodeText(std::string bytes, Diagnostics& diagnostics) {
                                  *utf16BigEndian ? "big-endian" : "little-endian"));
     bytes = std::move(text);
   }
-  if (const void* zero = std::memchr(bytes.data(), 0, bytes.size())) {
-    const auto offset = static_cast<std::size_t>(static_cast<const char*>(zero) - bytes.data());
+  if (const std::size_t offset = bytes.find('\0'); offset != std::string::npos) {
     const auto line =
         static_cast<std::uint32_t>(std::count(bytes.begin(), bytes.begin() + static_cast<long>(offset), '\n') + 1);
     const std::size_t lineStart = bytes.rfind('\n', offset == 0 ? 0 : offset - 1);
@@ -336,8 +335,8 @@ bool isObjDataStatement(std::string_view line) {
   std::size_t end = i;
   while (end < line.size() && !isBlank(line[end])) ++end;
   const std::string_view key = line.substr(i, end - i);
-  static constexpr std::string_view kData[] = {"v",  "vt",   "vn",  "vc",   "vp",  "f",   "fo", "l",
-                                               "p",  "curv", "curv2", "surf", "parm", "trim", "hole"};
+  static constexpr std::string_view kData[] = {"v", "vt",   "vn",    "vc",   "vp",   "f",    "fo",  "l",
+                                               "p", "curv", "curv2", "surf", "parm", "trim", "hole"};
   for (std::string_view k : kData) {
     if (k == key) return true;
   }

@@ -180,7 +180,7 @@ TEST(ImageFiles, NetpbmEncodingsOfOnePictureAgree) {
   // 16-bit samples are not rounded to 8 bits: some sample is not a multiple of 257.
   bool fine = false;
   for (std::size_t i = 0; i + 1 < rgb16a->pixels.size(); i += 2) {
-    const unsigned v = rgb16a->pixels[i] | (rgb16a->pixels[i + 1] << 8);
+    const unsigned v = rgb16a->pixels[i] | (unsigned{rgb16a->pixels[i + 1]} << 8);
     fine = fine || v % 257 != 0;
   }
   EXPECT_TRUE(fine);

@@ -284,7 +284,7 @@ TEST(ModelFiles, EveryFileInTheSharedModelsFolderHasACase) {
 
 // ---- What the counts do not show ----------------------------------------------------------------
 
-Result<LoadedModel> load(const char* path, LoadOptions options = quiet()) {
+Result<LoadedModel> load(const char* path, const LoadOptions& options = quiet()) {
   return loadModel(modelsDir() / path, options);
 }
 
@@ -330,9 +330,9 @@ TEST(ModelFiles, ConcavePolygonsAreTriangulatedInsideTheirOutline) {
     double polygonArea = 0;
     std::size_t edge = 0, tri = 0;
     for (std::uint32_t s : m.facetSizes) {
-      std::vector<Vec3> corners;
-      for (std::uint32_t k = 0; k < s; ++k) corners.push_back(m.positions[m.edges[edge + 2 * k]]);
-      edge += 2 * s;
+      std::vector<Vec3> corners(s);
+      for (std::size_t k = 0; k < s; ++k) corners[k] = m.positions[m.edges[edge + 2 * k]];
+      edge += 2 * std::size_t{s};
       Vec3 n{0, 0, 0};
       for (std::size_t i = 0; i < corners.size(); ++i) {
         const Vec3& a = corners[i];

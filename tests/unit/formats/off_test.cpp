@@ -23,7 +23,7 @@ constexpr const char* kTetra =
     "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 
 TEST(Off, PlainHeaderHeaderlessAndCountsOnTheHeaderLine) {
-  for (std::string text :
+  for (const std::string& text :
        {std::string("OFF\n4 4 6\n") + kTetra, std::string("4 4 6\n") + kTetra, std::string("OFF 4 4 6\n") + kTetra,
         std::string("# tetra\nOFF # keyword\n\n4 4 6\n") + kTetra}) {
     auto model = off(text);

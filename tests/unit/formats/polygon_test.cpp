@@ -35,8 +35,8 @@ TEST(Polygon, ConcaveShapesInEveryOrientation) {
                         Mat4::rotationX(180),
                         Mat4::rotation(37, normalize(Vec3{1, 2, 3}))};
   for (const Mat4& turn : turns) {
-    std::vector<Vec3> p;
-    for (const Vec3& v : flat) p.push_back(turn.transformPoint(v));
+    std::vector<Vec3> p(flat.size());
+    for (std::size_t i = 0; i < flat.size(); ++i) p[i] = turn.transformPoint(flat[i]);
     std::vector<std::uint32_t> tris;
     ASSERT_TRUE(triangulatePolygon(p, tris, 1'000'000));
     ASSERT_EQ(tris.size(), 3 * (p.size() - 2));
@@ -47,8 +47,8 @@ TEST(Polygon, ConcaveShapesInEveryOrientation) {
 }
 
 TEST(Polygon, TheBudgetBoundsTheWorkAndStillGivesNMinusTwo) {
-  std::vector<Vec3> zigzag;
-  for (int i = 0; i < 400; ++i) zigzag.push_back({static_cast<float>(i), (i % 2) ? 1.0f : 0.0f, 0});
+  std::vector<Vec3> zigzag(400);
+  for (std::size_t i = 0; i < 400; ++i) zigzag[i] = {static_cast<float>(i), (i % 2) ? 1.0f : 0.0f, 0};
   zigzag.push_back({399, -5, 0});
   zigzag.push_back({0, -5, 0});
   std::vector<std::uint32_t> tris;
