@@ -103,6 +103,13 @@ Sniffed sniff(std::string_view text) {
 }  // namespace
 
 Result<LoadedModel> loadModel(const std::filesystem::path& path, const LoadOptions& options) {
+  // OBJ files are read a chunk at a time (the text is never whole in memory); UTF-16 text, OFF
+  // content in a .obj file, and other names go through the whole-file path below.
+  if (lowerAscii(path.extension().string()) == ".obj") {
+    bool fallback = false;
+    auto model = readObjStreamed(path, options, fallback);
+    if (!fallback) return model;
+  }
   auto bytes = readFileBytes(path, options.limits.maxFileBytes);
   if (!bytes) return std::unexpected(bytes.error());
   Diagnostics decoding(path.string(), options.limits.maxWarnings, options.logWarnings);

@@ -10,7 +10,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <memory>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -94,21 +96,35 @@ class ObjParser {
   // ---- The line loop ---------------------------------------------------------------------------
 
   Result<LoadedModel> parseText(std::string_view text) {
-    std::filesystem::path stemPath(name_);
-    defaultObjectName_ = stemPath.stem().string();
-    if (defaultObjectName_.empty()) defaultObjectName_ = "object";
-    groupIds_.reserve(16);
-    LineReader lines(text, LineReader::Continuation::kObjData);
+    if (auto r = parseLines(text); !r) return std::unexpected(r.error());
+    std::string().swap(owned_);  // the text is parsed: its memory goes before the meshes are built
+    return finish();
+  }
+
+ public:
+  /// Parses whole lines; called once for a text in memory, or chunk by chunk for a file.
+  Result<void> parseLines(std::string_view text) {
+    if (defaultObjectName_.empty()) {
+      defaultObjectName_ = std::filesystem::path(name_).stem().string();
+      if (defaultObjectName_.empty()) defaultObjectName_ = "object";
+    }
+    LineReader lines(text, LineReader::Continuation::kObjData, nextLine_);
     while (auto raw = lines.next()) {
       line_ = *raw;
       lineNumber_ = lines.number();
       if (auto r = statement(); !r) return std::unexpected(r.error());
     }
+    nextLine_ = lines.nextNumber();
     line_ = {};
-    std::string().swap(owned_);  // the text is parsed: its memory goes before the meshes are built
-    return finish();
+    return {};
   }
+  [[nodiscard]] std::uint32_t nextLine() const { return nextLine_; }
+  Diagnostics& diagnostics() { return d_; }
 
+  /// Everything parsed: resolves materials, builds the meshes.
+  Result<LoadedModel> finish() { return finishParse(); }
+
+ private:
   std::uint32_t col(const char* at) const { return static_cast<std::uint32_t>(at - line_.data()) + 1; }
   std::uint32_t col(std::size_t offset) const { return static_cast<std::uint32_t>(offset) + 1; }
   std::string here(std::size_t offset) const { return d_.where(lineNumber_, col(offset)); }
@@ -796,7 +812,7 @@ class ObjParser {
 
   // ---- The end ----------------------------------------------------------------------------------
 
-  Result<LoadedModel> finish() {
+  Result<LoadedModel> finishParse() {
     LoadedModel model;
     model.format = ModelFormat::kObj;
     model.extended = extended_;
@@ -843,12 +859,7 @@ class ObjParser {
     // Objects without geometry still mean something when they place or parent others (an
     // Extended OBJ hierarchy whose geometry comes from other files).
     bool anyTransformObject = false;
-    for (const ObjectBuild& o : objects_) {
-      const ModelObject& m = o.object;
-      anyTransformObject = anyTransformObject || !m.parent.empty() || m.position != Vec3{0, 0, 0} ||
-                           m.rotation != Vec3{0, 0, 0} || m.scale != Vec3{1, 1, 1} || !m.colorMap.empty() ||
-                           !m.reflectionMap.empty() || !m.bumpMap.empty();
-    }
+    for (const ObjectBuild& o : objects_) anyTransformObject = anyTransformObject || placesSomething(o.object);
     if (!anyGeometry && !anyInstance && !anyTransformObject) {
       if (firstSkip_) {
         return fail(Errc::kParse, firstSkip_->message + " (nothing else in the file could be drawn)",
@@ -868,7 +879,7 @@ class ObjParser {
     for (std::size_t i = 0; i < objects_.size(); ++i) {
       ObjectBuild& o = objects_[i];
       lastMesh_ = i == lastWithGeometry;
-      if (!o.hasElements && !o.explicitObject && o.object.parent.empty() && o.object.instanceOf.empty()) continue;
+      if (!o.hasElements && !o.explicitObject && o.object.instanceOf.empty() && !placesSomething(o.object)) continue;
       if (o.hasElements && !o.object.instanceOf.empty()) {
         d_.warn(o.instanceLine, 0,
                 fmt::format("object '{}' has geometry of its own and is an instance of '{}'; the shared geometry is "
@@ -883,6 +894,13 @@ class ObjParser {
     model.warnings = d_.finish();
     for (Diagnostic& w : libraryWarnings_) model.warnings.push_back(std::move(w));
     return model;
+  }
+
+  /// True for an object that means something without geometry: it is placed, parented or
+  /// textured.
+  static bool placesSomething(const ModelObject& m) {
+    return !m.parent.empty() || m.position != Vec3{0, 0, 0} || m.rotation != Vec3{0, 0, 0} ||
+           m.scale != Vec3{1, 1, 1} || !m.colorMap.empty() || !m.reflectionMap.empty() || !m.bumpMap.empty();
   }
 
   runtime::Material materialFor(std::uint32_t id) const {
@@ -1032,6 +1050,7 @@ class ObjParser {
 
   std::string_view line_;
   std::uint32_t lineNumber_ = 0;
+  std::uint32_t nextLine_ = 1;
   std::size_t keyAt_ = 0, argsAt_ = 0, argsEnd_ = 0;
 
   std::vector<Vec3> positions_;
@@ -1072,6 +1091,131 @@ class ObjParser {
 };
 
 }  // namespace
+
+namespace {
+
+bool isLineEnd(char c) { return c == '\n' || c == '\r'; }
+
+/// Line ends in `text` ("\r\n" is one, a lone "\r" is one).
+std::uint32_t countLineEnds(std::string_view text) {
+  std::uint32_t n = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\n' || (text[i] == '\r' && (i + 1 >= text.size() || text[i + 1] != '\n'))) ++n;
+  }
+  return n;
+}
+
+/// Where to cut a chunk so that it holds whole statements: after the last line end, but before
+/// a trailing "\r" (its "\n" may be in the next chunk) and before lines ending in a backslash
+/// (they continue in the next chunk). 0 when nothing can be parsed yet.
+std::size_t wholeLines(std::string_view buffer) {
+  std::size_t cut = buffer.find_last_of("\n\r");
+  if (cut == std::string_view::npos) return 0;
+  if (buffer[cut] == '\r' && cut + 1 == buffer.size()) {
+    if (cut == 0) return 0;
+    cut = buffer.find_last_of("\n\r", cut - 1);
+    if (cut == std::string_view::npos) return 0;
+  }
+  ++cut;
+  while (cut > 0) {
+    // The last line before the cut, without its end.
+    std::size_t end = cut;
+    while (end > 0 && isLineEnd(buffer[end - 1])) --end;
+    std::size_t start = end;
+    while (start > 0 && !isLineEnd(buffer[start - 1])) --start;
+    std::string_view line = buffer.substr(start, end - start);
+    while (!line.empty() && isBlank(line.back())) line.remove_suffix(1);
+    if (line.empty() || line.back() != '\\') break;
+    cut = start;
+  }
+  return cut;
+}
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+
+}  // namespace
+
+Result<LoadedModel> readObjStreamed(const std::filesystem::path& path, const LoadOptions& options, bool& fallback,
+                                    std::size_t chunkBytes) {
+  fallback = false;
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || !std::filesystem::is_regular_file(path, ec)) {
+    fallback = true;  // the whole-file reader says what is wrong
+    return fail(Errc::kNotFound, "", path.string());
+  }
+  if (size > options.limits.maxFileBytes) {
+    return fail(
+        Errc::kResourceExhausted,
+        fmt::format("the file has {} bytes, more than the limit of {} bytes", size, options.limits.maxFileBytes),
+        path.string());
+  }
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
+  if (!file) {
+    fallback = true;
+    return fail(Errc::kIo, "", path.string());
+  }
+  // A look at the start: UTF-16 and OFF content go to the whole-file reader.
+  std::string head(4096, '\0');
+  head.resize(std::fread(head.data(), 1, head.size(), file.get()));
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(head[i]); };
+  if (head.size() >= 2 && ((byte(0) == 0xFE && byte(1) == 0xFF) || (byte(0) == 0xFF && byte(1) == 0xFE) ||
+                           (head.size() >= 4 && (byte(0) == 0 || byte(1) == 0)))) {
+    fallback = true;
+    return fail(Errc::kUnsupported, "", path.string());
+  }
+  {
+    std::string_view h = head;
+    while (!h.empty() && (isBlank(h.front()) || isLineEnd(h.front()))) h.remove_prefix(1);
+    if (h.starts_with("\xEF\xBB\xBF")) h.remove_prefix(3);
+    const std::string_view word = h.substr(0, std::min(h.find_first_of(" \t\r\n"), h.size()));
+    if (word.size() >= 3 && word.substr(word.size() - 3) == "OFF") {
+      fallback = true;
+      return fail(Errc::kUnsupported, "", path.string());
+    }
+  }
+  std::rewind(file.get());
+  ObjParser parser(path.string(), path.parent_path(), options, true);
+  std::string buffer;
+  bool first = true, eof = false;
+  chunkBytes = std::max<std::size_t>(chunkBytes, 1);
+  while (true) {
+    const std::size_t old = buffer.size();
+    buffer.resize(old + chunkBytes);
+    const std::size_t got = std::fread(buffer.data() + old, 1, chunkBytes, file.get());
+    buffer.resize(old + got);
+    if (got < chunkBytes) {
+      if (std::ferror(file.get())) return fail(Errc::kIo, "reading the file failed", path.string());
+      eof = true;
+    }
+    std::size_t fresh = old;
+    if (first && buffer.size() >= 3 && buffer.compare(0, 3, "\xEF\xBB\xBF") == 0) {
+      buffer.erase(0, 3);
+      fresh = 0;
+    }
+    if (first && (buffer.size() >= 3 || eof)) first = false;
+    if (const std::size_t zero = buffer.find('\0', fresh); zero != std::string::npos) {
+      const std::string_view before(buffer.data(), zero);
+      const std::size_t lineStart = before.find_last_of("\n\r");
+      const std::size_t column = zero - (lineStart == std::string_view::npos ? 0 : lineStart + 1) + 1;
+      return parseError(
+          parser.diagnostics().where(parser.nextLine() + countLineEnds(before), static_cast<std::uint32_t>(column)),
+          "this is not a text file (it has a zero byte here); check that the right file was named");
+    }
+    const std::size_t cut = eof ? buffer.size() : wholeLines(buffer);
+    if (cut > 0) {
+      if (auto r = parser.parseLines(std::string_view(buffer.data(), cut)); !r) return std::unexpected(r.error());
+      buffer.erase(0, cut);
+    }
+    if (eof) break;
+  }
+  std::string().swap(buffer);
+  auto model = parser.finish();
+  if (model) model->path = path;
+  return model;
+}
 
 Result<LoadedModel> parseObjText(std::string_view text, const std::string& name, const std::filesystem::path& folder,
                                  const LoadOptions& options) {

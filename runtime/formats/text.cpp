@@ -326,9 +326,6 @@ bool splitStatementItems(std::string_view line, std::vector<StatementItem>& item
   return true;
 }
 
-namespace {
-
-/// True when the line is an OBJ statement whose arguments are numbers or vertex references.
 bool isObjDataStatement(std::string_view line) {
   std::size_t i = 0;
   while (i < line.size() && isBlank(line[i])) ++i;
@@ -342,8 +339,6 @@ bool isObjDataStatement(std::string_view line) {
   }
   return false;
 }
-
-}  // namespace
 
 // ---- Lines ------------------------------------------------------------------------------------
 

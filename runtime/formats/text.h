@@ -115,12 +115,15 @@ class LineReader {
   /// backslash continues on the next line, as the OBJ specification allows. Names and file
   /// names never continue, so that a name ending in a backslash reads back as written.
   enum class Continuation : std::uint8_t { kNone, kObjData };
-  explicit LineReader(std::string_view text, Continuation continuation = Continuation::kNone)
-      : text_(text), continuation_(continuation) {}
+  explicit LineReader(std::string_view text, Continuation continuation = Continuation::kNone,
+                      std::uint32_t firstLine = 1)
+      : text_(text), continuation_(continuation), nextNumber_(firstLine) {}
   /// \brief The next line without its end, or nothing at the end of the text. `number()` is its
   /// 1-based line number (the first line of a continued line).
   std::optional<std::string_view> next();
   [[nodiscard]] std::uint32_t number() const { return number_; }
+  /// \brief The number the next line will have.
+  [[nodiscard]] std::uint32_t nextNumber() const { return nextNumber_; }
   /// \brief 1-based column of `at`, a position inside the line `next()` returned last (after a
   /// continuation, columns count from the start of the joined line).
   [[nodiscard]] std::uint32_t column(std::string_view line, const char* at) const {
@@ -130,11 +133,15 @@ class LineReader {
  private:
   std::string_view text_;
   Continuation continuation_;
+  std::uint32_t nextNumber_;
   std::size_t pos_ = 0;
   std::uint32_t number_ = 0;
-  std::uint32_t nextNumber_ = 1;
   std::string joined_;
 };
+
+/// \brief True when an OBJ line is a vertex or element statement, whose arguments may continue
+/// on the next line after a backslash.
+bool isObjDataStatement(std::string_view line);
 
 /// \brief One item of a thesis-style statement line: `name[arg,arg]` or a bare word.
 struct StatementItem {

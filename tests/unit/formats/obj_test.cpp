@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "formats_test_util.h"
+#include "runtime/formats/obj_internal.h"
 #include "support/test_paths.h"
 
 namespace basalt::formats {
@@ -370,6 +371,63 @@ TEST(ObjFiles, MaterialLibrariesWithBlanksInTheirNamesAndSeveralPerLine) {
   EXPECT_EQ(std::filesystem::path(m.materials[0].diffuseMap), (dir / "sub" / "red wood.png").lexically_normal());
   EXPECT_TRUE(hasWarning(model->warnings, "material library 'missing.mtl' was not found"))
       << listWarnings(model->warnings);
+}
+
+// ---- Reading in chunks --------------------------------------------------------------------------
+
+// OBJ files are read a chunk at a time. Whatever the chunk size, the model and its warnings
+// (line and column included) are those of reading the whole text at once: a line, a "\r\n" or a
+// backslash continuation cut by a chunk boundary is put together again.
+// Example failure: a face split across two chunks read as two broken statements.
+TEST(ObjChunks, EveryChunkSizeGivesTheSameModelAsTheWholeText) {
+  const auto dir = basalt::test::scratchDir("obj-chunks");
+  std::vector<std::filesystem::path> files;
+  // Line ends, continuations and a byte-order mark that chunk boundaries must not break.
+  const std::string tricky =
+      "\xEF\xBB\xBFmtllib none.mtl\r\nv 0 0 0\r\nv 1 0 \\\r\n 0\rv 1 1 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 \\\n 3/1 \\\n"
+      " 4/1\no name\\\nv 2 2 2\nf -1 -2 -3\nf 1 2 99\n";
+  std::ofstream(dir / "tricky.obj", std::ios::binary) << tricky;
+  files.push_back(dir / "tricky.obj");
+  if (const auto models = test::modelsDir(); !models.empty()) {
+    for (const char* f : {"obj/assimp/spider.obj", "obj/tinyobjloader/test-nan.obj", "obj/threejs/verify.obj",
+                          "obj/assimp/box_without_lineending.obj", "obj/tinyobjloader/cornell_box.obj",
+                          "obj/assimp/number_formats.obj"}) {
+      files.push_back(models / f);
+    }
+  }
+  for (const auto& path : files) {
+    Diagnostics decoding(path.string(), 50, false);
+    auto text = decodeText(test::readText(path), decoding);
+    ASSERT_TRUE(text);
+    auto whole = readObjFile(*text, path, test::quiet());
+    ASSERT_TRUE(whole) << path << ": " << whole.error().describe();
+    for (std::size_t chunk : {std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{64}, std::size_t{4096}}) {
+      bool fallback = true;
+      auto streamed = readObjStreamed(path, test::quiet(), fallback, chunk);
+      ASSERT_FALSE(fallback) << path;
+      ASSERT_TRUE(streamed) << path << " in chunks of " << chunk << ": " << streamed.error().describe();
+      ASSERT_EQ(streamed->objects.size(), whole->objects.size()) << path << " " << chunk;
+      for (std::size_t i = 0; i < whole->objects.size(); ++i) {
+        EXPECT_TRUE(streamed->objects[i] == whole->objects[i]) << path << " object " << i << ", chunks of " << chunk;
+      }
+      EXPECT_EQ(streamed->warnings, whole->warnings) << path << ", chunks of " << chunk << "\n"
+                                                     << listWarnings(streamed->warnings) << "whole:\n"
+                                                     << listWarnings(whole->warnings);
+    }
+  }
+}
+
+TEST(ObjChunks, AZeroByteInALaterChunkIsFoundAtItsPlace) {
+  const auto dir = basalt::test::scratchDir("obj-chunks-zero");
+  std::string text;
+  for (int i = 0; i < 100; ++i) text += "v 0 0 0\r\n";
+  text += std::string("v 1") + '\0' + "\n";
+  std::ofstream(dir / "z.obj", std::ios::binary) << text;
+  bool fallback = false;
+  auto model = readObjStreamed(dir / "z.obj", test::quiet(), fallback, 16);
+  ASSERT_FALSE(fallback);
+  ASSERT_FALSE(model);
+  EXPECT_EQ(model.error().where(), (dir / "z.obj").string() + ":101:4");
 }
 
 }  // namespace
