@@ -411,7 +411,7 @@ ResolvedPath resolveReferencedFile(std::string_view name, const std::filesystem:
   }
   std::replace(cleaned.begin(), cleaned.end(), '\\', '/');
   // "C:/textures/wood.jpg" from another machine: only the last component can mean anything here.
-  const bool windowsAbsolute = cleaned.size() >= 2 && cleaned[1] == ':' &&
+  const bool windowsAbsolute = cleaned.size() >= 3 && cleaned[1] == ':' && cleaned[2] == '/' &&
                                ((cleaned[0] >= 'A' && cleaned[0] <= 'Z') || (cleaned[0] >= 'a' && cleaned[0] <= 'z'));
   const std::filesystem::path named(windowsAbsolute ? cleaned.substr(2) : cleaned);
   const std::filesystem::path direct = (named.is_absolute() ? named : base / named).lexically_normal();
