@@ -33,6 +33,7 @@ Mat4 Show::worldTransform(NodeId id) const {
 
 void Show::clear() {
   nodes_.clear();
+  terrains_.clear();
   parts_.clear();
   resolved_.clear();
   resolvedAt_.clear();
@@ -53,6 +54,26 @@ Bounds Show::sceneBounds() const {
     }
   }
   return b;
+}
+
+NodeId Show::addTerrain(SceneNode node, std::shared_ptr<const HeightField> heights) {
+  const NodeId id = addNode(std::move(node));
+  if (heights) terrains_.push_back(std::move(heights));
+  return id;
+}
+
+std::optional<float> Show::terrainHeightAt(float x, float z) const {
+  for (const auto& t : terrains_) {
+    if (auto h = t->heightAt(x, z)) return h;
+  }
+  return std::nullopt;
+}
+
+std::optional<NodeId> Show::findNode(std::string_view name) const {
+  for (NodeId i = 0; i < nodes_.size(); ++i) {
+    if (nodes_[i].name == name) return i;
+  }
+  return std::nullopt;
 }
 
 PartId Show::internPart(const std::string& name) {
@@ -123,6 +144,7 @@ void Show::resetAttributes() {
   backgroundImage_.clear();
   earthSky_ = {};
   stereo_ = {};
+  viewer_ = {};
 }
 
 void PerformanceMeter::recordFrame(const FrameCounts& counts, Nanos now) {
@@ -318,6 +340,8 @@ std::shared_ptr<const Mesh> makeColorCube() {
     for (std::uint32_t i : {0u, 1u, 1u, 2u, 2u, 3u, 3u, 0u}) mesh->edges.push_back(base + i);
     part.edgeIndexCount = 8;
     part.facetCount = 1;
+    part.firstFacet = static_cast<std::uint32_t>(mesh->facetSizes.size());
+    mesh->facetSizes.push_back(4);
     mesh->parts.push_back(std::move(part));
   }
   return mesh;

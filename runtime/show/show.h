@@ -20,6 +20,7 @@
 #include "runtime/math.h"
 #include "runtime/show/attributes.h"
 #include "runtime/show/mesh.h"
+#include "runtime/show/viewer.h"
 
 namespace basalt::runtime {
 
@@ -34,6 +35,13 @@ struct SceneNode {
   std::shared_ptr<const Mesh> mesh;  ///< null for grouping nodes; shared by instances
   std::vector<PartId> partIds;       ///< the Show part of each mesh part, same order
   bool visible = true;
+  /// Extended OBJ `usemap` maps (thesis C.2), resolved against the model's folder: the colour
+  /// map textures the node's parts that have no material map of their own; the spherical
+  /// reflection map and the bump map are recorded for the renderer ("" = none).
+  std::string colorMap;
+  std::string reflectionMap;
+  std::string bumpMap;
+  std::string source;  ///< the file the node was loaded from ("" for built-in geometry)
 };
 
 /// \brief A part as LAVA's "Part Selection" and per-part attributes see it.
@@ -101,6 +109,14 @@ class Show {
   /// so instances and repeated names are addressed together). Parents must be added first.
   NodeId addNode(SceneNode node);
   void setNodeTransform(NodeId id, const Mat4& local);
+  /// \brief The first node with this name.
+  [[nodiscard]] std::optional<NodeId> findNode(std::string_view name) const;
+  /// \brief Adds a terrain's grid node and keeps its height field for `terrainHeightAt`.
+  NodeId addTerrain(SceneNode node, std::shared_ptr<const HeightField> heights);
+  [[nodiscard]] const std::vector<std::shared_ptr<const HeightField>>& terrains() const { return terrains_; }
+  /// \brief Height of the first terrain under (x, z) in scene coordinates, if any: what keeps a
+  /// walking viewer on the ground (thesis §4.6).
+  [[nodiscard]] std::optional<float> terrainHeightAt(float x, float z) const;
   /// \brief The node's transform composed with all its parents'.
   [[nodiscard]] Mat4 worldTransform(NodeId id) const;
   /// \brief Removes all nodes and parts and resets every attribute: LAVA's "all attributes get
@@ -175,6 +191,10 @@ class Show {
   /// \brief Eye spacing and how stereo is shown; `global().stereo` switches it on.
   StereoSettings& stereo() { return stereo_; }
   [[nodiscard]] const StereoSettings& stereo() const { return stereo_; }
+  /// \brief The thesis' walk-through viewer (camera, projection, stereo eye spacing, navigation
+  /// bounds and speeds) as a `.sce` scene sets it.
+  Viewer& viewer() { return viewer_; }
+  [[nodiscard]] const Viewer& viewer() const { return viewer_; }
   PerformanceMeter& performance() { return performance_; }
   [[nodiscard]] const PerformanceMeter& performance() const { return performance_; }
 
@@ -208,6 +228,7 @@ class Show {
   PartId internPart(const std::string& name);
 
   std::vector<SceneNode> nodes_;
+  std::vector<std::shared_ptr<const HeightField>> terrains_;
   std::vector<PartState> parts_;
   PartStyle global_;
   mutable std::vector<PartStyle> resolved_;        // cache, one per part
@@ -230,6 +251,7 @@ class Show {
   std::string backgroundImage_;
   EarthSky earthSky_;
   StereoSettings stereo_;
+  Viewer viewer_;
   PerformanceMeter performance_;
   std::uint64_t frameNumber_ = 0;
 };
