@@ -105,10 +105,13 @@ StepResult Interpreter::step(Show& show, Host& host) {
   while (pc_ < program_.instrs.size()) {
     const Instr& in = program_.instrs[pc_];
     if (spent++ >= budget_) {
-      report(in, Severity::kWarning,
-             fmt::format("{} commands ran without a draw; the frame is drawn here so that the show goes on "
-                         "(put a draw in the loop)",
-                         budget_));
+      if (!budgetWarned_) {
+        budgetWarned_ = true;
+        report(in, Severity::kWarning,
+               fmt::format("{} commands ran without a draw; the frame is drawn here so that the show goes on "
+                           "(put a draw in the loop)",
+                           budget_));
+      }
       result.stop = StepStop::kBudget;
       result.line = in.line;
       result.jitterPass = jitterPass_;

@@ -133,6 +133,7 @@ class Interpreter {
   Vec2 userOffset_;
   bool quit_ = false;
   bool noFinalMove_ = false;
+  bool budgetWarned_ = false;
   int currentLight_ = 0;
   int currentPlane_ = 0;
   ObjectSource object_;
