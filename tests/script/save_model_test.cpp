@@ -8,58 +8,26 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include "runtime/script/save_model.h"
 #include "script_support.h"
+#include "support/test_paths.h"
 
 namespace basalt::script {
 namespace {
 
 using test::run;
 
-constexpr std::string_view kRichScript = R"(
-render.prim_type = markers
-render.prim_type "face 2" = wireframe
-lines.line_width "face 3" = 4.5
-front_surf.color = 0.3 0.6 0.9
-front_surf.specular_power = 7.123457
-front_surf.light_component = diffuse specular
-nurbs.param_style = iso_curves incr_silh_tess
-edges.show_edges = software
-markers.scale_factor "face 6" = 0.1
-lighting.switch [5] = on
-lighting.color [5] = 0.1 0.2 0.3
-lighting.direction [6] = 0.3 -0.4 -1
-lighting.angle [3] = 0.7
-depth_cue.mode = linear
-depth_cue.use_bg_color = on
-model_clipping.num_planes = 3
-model_clipping.normal [2] = 0 1 0
-annotation.up_vector = 0.5 0.5
-global.background_color = 0.05 0.1 0.15
-texture.method = vertex_level
-motion.global_x_rotate = 1.5
-motion.local_scale = 1.01
-motion.local_y_rotate = -2
-motion.num_frames = 50
-motion.start
-motion.local_stop
-view.object_center = minus_y
-view.perspective = 3.3
-view.view_scale = 0.9
-env.floor = coarse_grid
-position.global_y_rotate = 33.3
-position.local_x_translate = 0.1
-position.view_matrix = 1 0 0 0 0 1 0 0 0 0 1 0 0 0 -4 1
-texture.switch = video
-part.deselect "face 5"
-load_texture "wood.png"
-part.select "face 5"
-part.deselect "face 4"
-draw
-draw
-draw
-)";
+/// A script that changes many settings: tests/script/scripts/rich_state.mdl.
+std::string richScript() {
+  std::ifstream in(basalt::test::sourceDir() / "tests/script/scripts/rich_state.mdl");
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_FALSE(text.str().empty()) << "tests/script/scripts/rich_state.mdl is missing";
+  return text.str();
+}
 
 /// Every part of the Show that a script can set, compared field by field.
 void expectSameShow(const runtime::Show& a, const runtime::Show& b) {
@@ -92,7 +60,7 @@ void expectSameShow(const runtime::Show& a, const runtime::Show& b) {
 }
 
 TEST(SaveModel, RestoresEveryScriptableSetting) {
-  const auto original = run(kRichScript);
+  const auto original = run(richScript());
   ASSERT_EQ(original.count(Severity::kError), 0u) << original.messages[0].describe();
   const std::string saved = saveModel(original.show, original.object);
   const auto restored = run(saved);
@@ -102,7 +70,7 @@ TEST(SaveModel, RestoresEveryScriptableSetting) {
 }
 
 TEST(SaveModel, RunningMotionGoesOnTheSame) {
-  auto original = run(kRichScript);
+  auto original = run(richScript());
   auto restored = run(saveModel(original.show, original.object));
   ASSERT_GT(original.show.motion().framesLeft, 0);
   for (int i = 0; i < 60; ++i) {
