@@ -1,6 +1,5 @@
 #include "kiosk/check_mdl.h"
 
-#include <algorithm>
 #include <string>
 
 #include <fmt/format.h>
@@ -66,7 +65,7 @@ CheckResult checkMdl(const std::filesystem::path& file) {
   std::vector<Diagnostic> all = program.diagnostics;
   const std::vector<Diagnostic> more = checkScriptStatically(program, folder);
   all.insert(all.end(), more.begin(), more.end());
-  std::stable_sort(all.begin(), all.end(), [](const Diagnostic& a, const Diagnostic& b) { return a.line < b.line; });
+  script::sortByLine(all);
   for (const Diagnostic& d : all) {
     fmt::print("{}:{}: {}: {}\n", d.file, d.line, script::severityName(d.severity), d.message);
     if (d.severity == Severity::kError) ++result.errors;

@@ -181,7 +181,7 @@ class Def {
 };
 
 // Storage of global-only settings. `i` is the light or clip-plane index for indexed commands.
-#define BASALT_SLOT(expr) [](Show& s, int i) -> void* { return (void)i, static_cast<void*>(&(expr)); }
+#define BASALT_SLOT(expr) ([](Show& s, int i) -> void* { return (void)i, static_cast<void*>(&(expr)); })
 #define BASALT_LIGHT(field) BASALT_SLOT(s.lights()[static_cast<std::size_t>(i)].field)
 #define BASALT_PLANE(field) BASALT_SLOT(s.modelClipping().planes[static_cast<std::size_t>(i)].field)
 

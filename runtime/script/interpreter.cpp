@@ -417,7 +417,7 @@ bool Interpreter::applyValue(const Instr& in, const CommandDef& def, const void*
         float cur = 0;
         std::memcpy(&cur, static_cast<const std::byte*>(current) + i * sizeof(float), sizeof cur);
         double r = 0;
-        if (!combine(cur, values[in.count == 1 ? 0 : i], in.op, r)) {
+        if (!combine(static_cast<double>(cur), values[in.count == 1 ? 0 : i], in.op, r)) {
           report(in, Severity::kError,
                  fmt::format("{} {} 0: division by zero; the value stays as it was", def.name, assignOpText(in.op)));
           return false;
@@ -430,7 +430,7 @@ bool Interpreter::applyValue(const Instr& in, const CommandDef& def, const void*
         if (r < def.min || r > def.max) {
           report(in, Severity::kError,
                  fmt::format("{} would become {}, outside {} to {}; it stays {}", def.name, numberText(r),
-                             numberText(def.min), numberText(def.max), numberText(cur)));
+                             numberText(def.min), numberText(def.max), numberText(static_cast<double>(cur))));
           return false;
         }
         result[i] = f;

@@ -33,8 +33,7 @@ class Parser {
       parseLine();
     }
     closeOpenBlocks();
-    std::stable_sort(p_.diagnostics.begin(), p_.diagnostics.end(),
-                     [](const Diagnostic& a, const Diagnostic& b) { return a.line < b.line; });
+    sortByLine(p_.diagnostics);
   }
 
  private:
@@ -404,6 +403,20 @@ std::string_view severityName(Severity severity) {
 }
 
 std::string Diagnostic::describe() const { return fmt::format("{}:{}: {}", file, line, message); }
+
+void sortByLine(std::vector<Diagnostic>& diagnostics) {
+  // std::sort on (line, position) rather than std::stable_sort, whose temporary buffer
+  // libstdc++ 12 implements with a function clang-19 reports as deprecated.
+  std::vector<std::size_t> order(diagnostics.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return diagnostics[a].line != diagnostics[b].line ? diagnostics[a].line < diagnostics[b].line : a < b;
+  });
+  std::vector<Diagnostic> sorted;
+  sorted.reserve(diagnostics.size());
+  for (std::size_t i : order) sorted.push_back(std::move(diagnostics[i]));
+  diagnostics = std::move(sorted);
+}
 
 std::size_t Program::errorCount() const {
   std::size_t n = 0;

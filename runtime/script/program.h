@@ -65,6 +65,9 @@ struct Program {
 /// \brief Loops and jitter loops nest at most this deep (LAVA: 10).
 inline constexpr std::size_t kMaxNesting = 32;
 
+/// \brief Orders messages by line, keeping the order of messages about the same line.
+void sortByLine(std::vector<Diagnostic>& diagnostics);
+
 /// \brief Parses a script. `file` names it in messages.
 Program parseScript(std::string_view source, std::string file);
 

@@ -126,8 +126,9 @@ std::string defaultValue(const CommandDef& def, runtime::Show& show, runtime::Pa
   if (v.empty()) v = "(none)";
   if (def.scope == Scope::kIndexed) v += " (N = 0; see the defaults below)";
   if (def.kind == ValueKind::kFloat && def.count == 16) {
-    const Mat4 identity;
-    if (std::memcmp(storage, identity.m.data(), sizeof identity.m) == 0) v = "identity";
+    Mat4 matrix;
+    std::memcpy(matrix.m.data(), storage, sizeof matrix.m);
+    if (matrix == Mat4{}) v = "identity";
   }
   return v;
 }

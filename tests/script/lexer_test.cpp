@@ -6,8 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
-#include <cstring>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -169,8 +170,7 @@ TEST(Numbers, FloatsAreRoundedOnceFromTheText) {
   // 0.1 rounded straight to float, not through double: the same bits as the compiler's 0.1f.
   CNumber n;
   ASSERT_EQ(parseCNumber("0.1", n), NumberParse::kOk);
-  const float expected = 0.1f;
-  EXPECT_EQ(std::memcmp(&n.asFloat, &expected, sizeof expected), 0);
+  EXPECT_EQ(std::bit_cast<std::uint32_t>(n.asFloat), std::bit_cast<std::uint32_t>(0.1f));
 }
 
 TEST(Case, NamesCompareWithoutCase) {

@@ -34,7 +34,9 @@ TEST(OpEqualsTable, NumbersTakeItRotationsAndChoicesDoNot) {
     if (def.scope == Scope::kIndexed) target += " [2]";
     const std::string value = number ? "2" : (def.kind == ValueKind::kFile ? "\"f.png\"" : "on");
     for (const char* sign : {"+=", "-=", "*=", "/="}) {
-      const Program p = parse(target + " " + sign + " " + value);
+      std::string line = target;
+      line.append(" ").append(sign).append(" ").append(value);
+      const Program p = parse(line);
       EXPECT_EQ(p.errorCount() == 0, expected) << target << " " << sign;
     }
   }

@@ -260,9 +260,8 @@ TEST(CommandTable, PerPartCommandsStoreIntoTheAttributeTable) {
 TEST(Parse, EveryCommandInEveryValueForm) {
   for (const CommandDef& def : commands()) {
     const std::string line = sampleLine(def);
-    const Program p =
-        parse(line + "\n" + (def.action == Action::kLoop ? "end_loop\n" : "") +
-              (def.action == Action::kJitter ? "draw\nend_jitter\n" : "") + (def.action == Action::kEndLoop ? "" : ""));
+    const Program p = parse(line + "\n" + (def.action == Action::kLoop ? "end_loop\n" : "") +
+                            (def.action == Action::kJitter ? "draw\nend_jitter\n" : ""));
     if (def.action == Action::kEndLoop || def.action == Action::kEndJitter) {
       // An end alone is an error; with its opener it is the second instruction.
       const Program opened = parse(std::string(def.action == Action::kEndLoop ? "loop 2\n" : "jitter 2\n") + line);

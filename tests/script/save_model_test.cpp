@@ -7,7 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cstring>
+#include <bit>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 
@@ -29,6 +30,13 @@ std::string richScript() {
   return text.str();
 }
 
+bool sameBits(const Mat4& a, const Mat4& b) {
+  for (std::size_t i = 0; i < 16; ++i) {
+    if (std::bit_cast<std::uint32_t>(a.m[i]) != std::bit_cast<std::uint32_t>(b.m[i])) return false;
+  }
+  return true;
+}
+
 /// Every part of the Show that a script can set, compared field by field.
 void expectSameShow(const runtime::Show& a, const runtime::Show& b) {
   EXPECT_EQ(a.globalStyle(), b.globalStyle());
@@ -46,7 +54,9 @@ void expectSameShow(const runtime::Show& a, const runtime::Show& b) {
   EXPECT_EQ(a.backgroundKind(), b.backgroundKind());
   EXPECT_EQ(a.earthSky(), b.earthSky());
   // Bit for bit, so that -0 and 0 count as different.
-  EXPECT_EQ(std::memcmp(&a.position(), &b.position(), sizeof(runtime::Position)), 0) << "the matrices differ";
+  EXPECT_TRUE(sameBits(a.position().global, b.position().global)) << "the global matrix differs";
+  EXPECT_TRUE(sameBits(a.position().local, b.position().local)) << "the local matrix differs";
+  EXPECT_TRUE(sameBits(a.position().view, b.position().view)) << "the view matrix differs";
   ASSERT_EQ(a.partCount(), b.partCount());
   for (runtime::PartId id = 0; id < a.partCount(); ++id) {
     const runtime::PartState& pa = a.part(id);
