@@ -29,7 +29,9 @@ std::filesystem::path write(const std::filesystem::path& dir, const std::string&
 }
 
 bool eglAvailable(std::string& why) {
-  const auto dir = test::scratchDir("script-cli-probe");
+  // A folder of this test's own: ctest runs the tests of this file in parallel processes.
+  const auto dir = test::scratchDir(std::string("script-cli-probe-") +
+                                    ::testing::UnitTest::GetInstance()->current_test_info()->name());
   const auto probe = basalt({"run", "--frames", "1", "--headless", "--output-dir", dir.string()});
   why = probe.output;
   return probe.exitCode == 0;
