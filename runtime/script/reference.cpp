@@ -62,7 +62,7 @@ them the way to script a show with nobody at the controls:
   turned to show three faces, at rest, under LAVA's default lights.
 - `draw` ends a frame. A script is a sequence of frames, played at the show's frame rate, or as
   fast as the machine goes under the manual clock (`basalt run --fast`, and by default for a
-  script that ends with `quit`). Free-run motion advances once per frame.
+  script that has a `quit`). Free-run motion advances once per frame.
 - `loop N` ... `end_loop` repeat what is between them N times; loops nest (LAVA allowed 10
   levels, Basalt allows 32).
 - `jitter N` ... `end_jitter` repeat what is between them N times, each pass drawn with a
