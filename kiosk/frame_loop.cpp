@@ -20,16 +20,19 @@ void FrameLoop::applyInput(Nanos until) {
                       });
 }
 
-Result<void> FrameLoop::renderFrame(const FrameContext& context) {
+Result<void> FrameLoop::renderFrame(FrameContext& context) {
   for (FrameParticipant* p : participants_) {
     if (auto r = p->beforeDraw(context); !r) return r;
   }
   if (auto r = output_.beginFrame(); !r) return r;
   const render::Size size = output_.size();
-  renderer_.drawShow(show_, {0, 0, size.width, size.height});
+  renderer_.drawShow(show_, {0, 0, size.width, size.height}, [&](runtime::ViewTransforms& view) {
+    for (FrameParticipant* p : participants_) p->adjustView(context, view, size);
+  });
   for (FrameParticipant* p : participants_) {
     if (auto r = p->afterDraw(context, output_); !r) return r;
   }
+  if (!context.last && participantWantsStop()) context.last = true;
   if (hook_) {
     if (auto r = hook_(context.frame, context.last, output_); !r) return r;
   }
@@ -66,7 +69,7 @@ Result<FrameLoopStats> FrameLoop::run() {
     const bool last =
         stopRequested_ || participantWantsStop() || (config_.maxFrames >= 0 && frame + 1 == config_.maxFrames);
     applyInput(due);
-    const FrameContext context{frame, due, last};
+    FrameContext context{frame, due, last};
     if (auto r = renderFrame(context); !r) return std::unexpected(r.error());
     if (frame == 0) stats.firstFrameSeconds = toSeconds(wall.now() - wallStart);
     stats.frames = frame + 1;
@@ -75,7 +78,7 @@ Result<FrameLoopStats> FrameLoop::run() {
     show_.performance().recordFrame(renderer_.takeFrameCounts(), wall.now());
     show_.advanceFrame();
     for (FrameParticipant* p : participants_) p->afterPresent(context);
-    if (last) break;
+    if (context.last) break;
   }
   stats.wallSeconds = toSeconds(wall.now() - wallStart);
   return stats;

@@ -40,6 +40,13 @@ class FrameParticipant {
     (void)frame;
     return {};
   }
+  /// \brief Between computing the view and drawing: may change how this frame is seen (a
+  /// script's sub-pixel jitter). `size` is the output's size in pixels.
+  virtual void adjustView(const FrameContext& frame, runtime::ViewTransforms& view, render::Size size) {
+    (void)frame;
+    (void)view;
+    (void)size;
+  }
   /// \brief After drawing, before presenting: read-back users (snapshots, recording, tests).
   virtual Result<void> afterDraw(const FrameContext& frame, render::Output& output) {
     (void)frame;
@@ -49,7 +56,8 @@ class FrameParticipant {
   /// \brief After presenting and after the show advanced: metrics, watchdog pings.
   virtual void afterPresent(const FrameContext& frame) { (void)frame; }
   /// \brief True when this participant wants the loop to end after the current frame (a
-  /// script's `quit`, the end of a recording).
+  /// script's `quit`, the end of a recording). Asked before each frame and again after the
+  /// participants' afterDraw(), so that a frame can become the last one while it is made.
   [[nodiscard]] virtual bool wantsStop() const { return false; }
 };
 
@@ -98,7 +106,8 @@ class FrameLoop {
 
  private:
   void applyInput(Nanos until);
-  Result<void> renderFrame(const FrameContext& context);
+  /// Draws one frame; `context.last` becomes true when a participant asks to stop during it.
+  Result<void> renderFrame(FrameContext& context);
   [[nodiscard]] bool participantWantsStop() const;
 
   FrameLoopConfig config_;

@@ -15,12 +15,15 @@
 #include "kiosk/commands.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/options.h"
+#include "kiosk/script_player.h"
 #include "media/image_io.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/event_loop.h"
 #include "runtime/image.h"
 #include "runtime/log.h"
+#include "runtime/script/interpreter.h"
+#include "runtime/script/save_model.h"
 #include "runtime/show/show.h"
 
 namespace basalt::kiosk {
@@ -72,12 +75,17 @@ Result<void> parseSize(std::string_view text, RunOptions& run) {
 }  // namespace
 
 std::string_view runUsage() {
-  return R"(Usage: basalt run [options]
+  return R"(Usage: basalt run [options] [SHOW]
 
 Plays a show. With no show given it plays the default show: LAVA's start-up scene, a
 coloured cube on black, 500x500, turning slowly under LAVA's default lights. With no display
 it renders offscreen through EGL (headless) and writes a snapshot of the last frame.
 Without --frames or --seconds it runs until interrupted (Ctrl-C, SIGTERM) and exits cleanly.
+
+SHOW may be a LAVA script (.mdl), run as `lava -file SHOW.mdl` ran it: each `draw` is one
+frame, `quit` ends the run, and a bad line is reported and skipped while the show goes on.
+A script that quits runs as fast as possible on the manual clock unless --realtime is given.
+'basalt help script' lists the language; 'basalt check SHOW.mdl' finds errors without running.
 
 Options:
   --frames N         stop after N frames
@@ -91,6 +99,8 @@ Options:
   --realtime         pace frames on the system clock at the frame rate
   --fast             step a manual clock exactly 1/fps per frame and render as fast as
                      possible (the default headless when --frames or --seconds is given)
+  --save-image PATH  where a script's save_image writes (default: OUTPUT_DIR/ras.im32)
+  --save-model PATH  at the end, write the show as a LAVA script (LAVA's Save Model)
   -h, --help         this text
 
 Exit status: 0 when the show ran, 1 when it could not start or failed, 2 for usage errors.
@@ -108,13 +118,20 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--output-dir", true},
                               {"--fps", true},
                               {"--realtime"},
-                              {"--fast"}});
+                              {"--fast"},
+                              {"--save-image", true},
+                              {"--save-model", true}});
   if (!parsed) return std::unexpected(parsed.error());
   RunOptions run;
   for (const ParsedOption& o : *parsed) {
     if (o.name.empty()) {
-      return fail(Errc::kInvalidArgument,
-                  fmt::format("unexpected argument '{}' for 'basalt run'; see 'basalt run --help'", o.value));
+      if (run.show) {
+        return fail(Errc::kInvalidArgument,
+                    fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value, run.show->string()));
+      }
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
+      run.show = std::filesystem::path(o.value);
+      continue;
     }
     if (o.name == "--help") {
       run.help = true;
@@ -144,6 +161,12 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       run.clock = ClockMode::kSystem;
     } else if (o.name == "--fast") {
       run.clock = ClockMode::kManual;
+    } else if (o.name == "--save-image") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--save-image needs a file name");
+      run.saveImage = std::filesystem::path(o.value);
+    } else if (o.name == "--save-model") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--save-model needs a file name");
+      run.saveModel = std::filesystem::path(o.value);
     }
   }
   return run;
@@ -161,7 +184,17 @@ int runMain(std::span<const std::string_view> args) {
 
 int runShow(const RunOptions& options) {
   const std::filesystem::path snapshotPath = options.snapshot ? *options.snapshot : options.outputDir / "snapshot.png";
+  if (options.show && !isScriptFile(*options.show)) {
+    return usageError(fmt::format("basalt run plays LAVA scripts (.mdl); '{}' is not one", options.show->string()));
+  }
   if (auto r = checkWritableFolder(snapshotPath); !r) return failWith(r.error(), "cannot start");
+
+  std::optional<script::Interpreter> script;
+  if (options.show) {
+    auto loaded = loadScript(*options.show);
+    if (!loaded) return failWith(loaded.error(), "cannot start");
+    script.emplace(std::move(*loaded));
+  }
 
   std::int64_t maxFrames = -1;
   if (options.frames) maxFrames = *options.frames;
@@ -169,7 +202,9 @@ int runShow(const RunOptions& options) {
     const auto fromSeconds = static_cast<std::int64_t>(std::ceil(*options.seconds * options.fps));
     maxFrames = maxFrames < 0 ? fromSeconds : std::min(maxFrames, fromSeconds);
   }
-  const bool manual = options.clock == ClockMode::kManual || (options.clock == ClockMode::kAuto && maxFrames >= 0);
+  // A script that quits is a batch job (LAVA's test scripts): it runs as fast as it can.
+  const bool batch = maxFrames >= 0 || (script && scriptQuits(script->program()));
+  const bool manual = options.clock == ClockMode::kManual || (options.clock == ClockMode::kAuto && batch);
   SystemClock systemClock;
   ManualClock manualClock;
   const Clock& clock = manual ? static_cast<const Clock&>(manualClock) : systemClock;
@@ -195,12 +230,22 @@ int runShow(const RunOptions& options) {
   auto renderer = render::Renderer::create();
   if (!renderer) return failWith(renderer.error(), "cannot set up the renderer");
 
-  runtime::Show show = runtime::Show::makeDefault();
+  runtime::Show show = script ? script::startupShow() : runtime::Show::makeDefault();
   FrameLoop frameLoop({options.fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output,
                       **renderer);
 
   running = &frameLoop;
   if (stopEarly) frameLoop.requestStop();
+  std::optional<ScriptPlayer> player;
+  if (script) {
+    ScriptPlayerOptions playerOptions;
+    playerOptions.outputDir = options.outputDir;
+    if (options.saveImage) playerOptions.saveImage = *options.saveImage;
+    player.emplace(std::move(*script), show, **renderer, std::move(playerOptions));
+    player->setReporter(printScriptDiagnostic);
+    frameLoop.addParticipant(*player);
+  }
+
 
   Image snapshot;
   bool snapshotWritten = false;
@@ -215,12 +260,22 @@ int runShow(const RunOptions& options) {
   auto stats = frameLoop.run();
   if (!stats) return failWith(stats.error(), "the show stopped");
 
+  if (options.saveModel) {
+    const script::ObjectSource object = player ? player->interpreter().objectSource() : script::ObjectSource{};
+    if (auto r = writeSavedModel(*options.saveModel, script::saveModel(show, object)); !r) {
+      return failWith(r.error(), "cannot save the model");
+    }
+  }
+
   const double fps = stats->wallSeconds > 0 ? static_cast<double>(stats->frames) / stats->wallSeconds : 0;
-  fmt::print("basalt: played the default show: {} frames in {:.2f} s ({:.1f} frames per second, {} clock)\n",
-             stats->frames, stats->wallSeconds, fps, manual ? "manual" : "system");
+  const std::string what = options.show ? options.show->string() : std::string("the default show");
+  fmt::print("basalt: played {}: {} frames in {:.2f} s ({:.1f} frames per second, {} clock)\n", what, stats->frames,
+             stats->wallSeconds, fps, manual ? "manual" : "system");
   fmt::print("basalt: output: {}\n", (*output)->describe());
   fmt::print("basalt: first frame after {:.1f} ms\n", stats->firstFrameSeconds * 1000);
+  if (player) printScriptSummary(*player);
   if (snapshotWritten) fmt::print("basalt: snapshot written to {}\n", snapshotPath.string());
+  if (options.saveModel) fmt::print("basalt: model saved to {}\n", options.saveModel->string());
   std::fflush(stdout);
   return 0;
 }

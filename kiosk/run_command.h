@@ -19,16 +19,19 @@ enum class ClockMode : std::uint8_t { kAuto, kSystem, kManual };
 
 /// \brief Options of `basalt run`.
 struct RunOptions {
-  bool help = false;                   ///< --help was given
-  std::optional<std::int64_t> frames;  ///< stop after this many frames
-  std::optional<double> seconds;       ///< stop after this much show time
-  std::uint32_t width = 500;           ///< LAVA's start-up window is 500 x 500
+  bool help = false;                          ///< --help was given
+  std::optional<std::filesystem::path> show;  ///< the show to play: a LAVA script (.mdl)
+  std::optional<std::int64_t> frames;         ///< stop after this many frames
+  std::optional<double> seconds;              ///< stop after this much show time
+  std::uint32_t width = 500;                  ///< LAVA's start-up window is 500 x 500
   std::uint32_t height = 500;
   bool headless = false;                          ///< force the offscreen output
   std::optional<std::filesystem::path> snapshot;  ///< where the last frame goes
   std::filesystem::path outputDir = "out";        ///< default folder for snapshots
   double fps = 60;
   ClockMode clock = ClockMode::kAuto;
+  std::optional<std::filesystem::path> saveImage;  ///< a script's bare save_image writes this
+  std::optional<std::filesystem::path> saveModel;  ///< write the show as .mdl at the end
 };
 
 /// \brief Parses the arguments after `run`.

@@ -1002,18 +1002,23 @@ void Renderer::draw(const Show& show, const runtime::ViewTransforms& view, const
   frameCounts_.facets += counts_.facets;
 }
 
-void Renderer::drawShow(const Show& show, const Viewport& viewport) {
+void Renderer::drawShow(const Show& show, const Viewport& viewport,
+                        const std::function<void(runtime::ViewTransforms&)>& adjust) {
   const float aspect =
       static_cast<float>(std::max(viewport.width, 1U)) / static_cast<float>(std::max(viewport.height, 1U));
+  auto adjusted = [&adjust](runtime::ViewTransforms view) {
+    if (adjust) adjust(view);
+    return view;
+  };
   if (show.global().stereo) {
     const float half = 0.5f * show.stereo().eyeSpacing;
-    drawAnaglyph(show, runtime::computeEyeView(show, aspect, -half), runtime::computeEyeView(show, aspect, half),
-                 viewport);
+    drawAnaglyph(show, adjusted(runtime::computeEyeView(show, aspect, -half)),
+                 adjusted(runtime::computeEyeView(show, aspect, half)), viewport);
     return;
   }
   ViewPass pass;
   pass.viewport = viewport;
-  draw(show, runtime::computeView(show, aspect), pass);
+  draw(show, adjusted(runtime::computeView(show, aspect)), pass);
 }
 
 void Renderer::drawAnaglyph(const Show& show, const runtime::ViewTransforms& left, const runtime::ViewTransforms& right,

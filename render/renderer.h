@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -86,8 +87,10 @@ class Renderer {
   /// \brief Draws one view as `pass` says.
   void draw(const runtime::Show& show, const runtime::ViewTransforms& view, const ViewPass& pass);
   /// \brief The show as its settings ask: LAVA's view fitted to the viewport, in anaglyph
-  /// stereo when `global().stereo` is on. What the frame loop calls.
-  void drawShow(const runtime::Show& show, const Viewport& viewport);
+  /// stereo when `global().stereo` is on. What the frame loop calls. `adjust`, when given, may
+  /// change each computed view before it is drawn (a script's sub-pixel jitter).
+  void drawShow(const runtime::Show& show, const Viewport& viewport,
+                const std::function<void(runtime::ViewTransforms&)>& adjust = {});
   /// \brief Thesis §5.1 anaglyph: the background once, then the scene for the left eye in red
   /// and for the right eye in green and blue.
   void drawAnaglyph(const runtime::Show& show, const runtime::ViewTransforms& left,
