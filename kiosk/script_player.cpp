@@ -21,6 +21,7 @@
 #include <fmt/std.h>
 
 #include "media/image_io.h"
+#include "runtime/formats/model.h"
 #include "runtime/log.h"
 
 namespace basalt::kiosk {
@@ -179,11 +180,22 @@ Result<const Image*> ScriptPlayer::currentPicture() {
 }
 
 Result<void> ScriptPlayer::loadObject(const std::filesystem::path& file, runtime::Show& show) {
-  (void)show;
-  return fail(Errc::kUnsupported,
-              "3D object files cannot be loaded by this build yet (the OBJ and OFF loaders are still to come); "
-              "the object stays as it is (load_color_cube gives LAVA's cube)",
-              file.string());
+  auto model = formats::loadModel(file);
+  if (!model) return std::unexpected(model.error());
+  for (const formats::Diagnostic& w : model->warnings) warn(w.describe());
+  if (auto r = formats::replaceObject(show, *model); !r) return r;
+  // The parts name their textures by file (material maps, Extended OBJ colour and reflection
+  // maps); each file is read once, and one that cannot be read leaves its parts untextured.
+  for (runtime::PartId id = 0; id < show.partCount(); ++id) {
+    const runtime::PartState& part = show.part(id);
+    for (const std::string* name : {&part.texture, &part.reflectionTexture}) {
+      if (name->empty() || renderer_.textures().find(*name) != nullptr) continue;
+      auto image = media::readImage(*name);
+      auto uploaded = image ? renderer_.textures().setImage(*name, *image) : Result<void>(std::unexpected(image.error()));
+      if (!uploaded) warn(fmt::format("the texture of part '{}' is not shown: {}", part.name, uploaded.error().describe()));
+    }
+  }
+  return {};
 }
 
 Result<void> ScriptPlayer::loadTexture(const std::filesystem::path& file, const std::string& name) {
@@ -250,7 +262,7 @@ bool ScriptPlayer::renders(Feature feature) const {
   // What render::Renderer draws today. As the renderer learns a feature, it moves up here, and
   // scripts stop being told that it is not rendered yet.
   switch (feature) {
-    case Feature::kRendered: return true;
+    case Feature::kRendered:
     case Feature::kRasterOp:
     case Feature::kMarkerShapes:
     case Feature::kAntialiasing:
@@ -260,16 +272,16 @@ bool ScriptPlayer::renders(Feature feature) const {
     case Feature::kFillStyle:
     case Feature::kTransparency:
     case Feature::kEdges:
-    case Feature::kNurbs:
-    case Feature::kPicking:
     case Feature::kDepthCue:
     case Feature::kTexture:
     case Feature::kModelClipping:
-    case Feature::kAnnotation:
-    case Feature::kSingleBuffering:
     case Feature::kStereo:
     case Feature::kFloor:
-    case Feature::kShadow:
+    case Feature::kShadow: return true;
+    case Feature::kNurbs:
+    case Feature::kPicking:
+    case Feature::kAnnotation:
+    case Feature::kSingleBuffering:
     case Feature::kViewMatrix:
     case Feature::kDrawNoClear:
     case Feature::kNoFinalMove:

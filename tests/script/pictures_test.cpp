@@ -123,5 +123,43 @@ TEST_F(Pictures, SaveModelGivesTheSamePictureBitForBit) {
   }
 }
 
+
+TEST_F(Pictures, LoadObjectShowsAModelWithItsMaterials) {
+  // The Cornell box from the shared test data (tinyobjloader's), beside its material library.
+  const auto source = basalt::test::testdataDir() / "models/obj/tinyobjloader";
+  if (!std::filesystem::exists(source / "cornell_box.obj")) GTEST_SKIP() << "no shared test data at " << source;
+  const auto script = writeScript("cornell", R"(load_object "cornell_box.obj"
+position.global_y_rotate = 180
+draw
+render.prim_type red_wall = wireframe
+draw
+quit
+)");
+  std::filesystem::copy_file(source / "cornell_box.obj", dir_ / "cornell_box.obj");
+  std::filesystem::copy_file(source / "cornell_box.mtl", dir_ / "cornell_box.mtl");
+  const auto played = stage_->play(script, 10, {0, 1}, {0, 1});
+  EXPECT_EQ(played.count(Severity::kError), 0u) << "the model loads without errors";
+  ASSERT_EQ(played.stats.frames, 2);
+  const runtime::Show& shown = played.at(0).show;
+  EXPECT_EQ(shown.partCount(), 8u) << "the box's eight objects with faces become parts (front_wall has none)";
+  const auto redWall = shown.findPart("red_wall");
+  ASSERT_TRUE(redWall.has_value()) << "parts are named after the file's objects";
+  EXPECT_EQ(played.at(1).show.part(*redWall).own.render.primType, runtime::PrimType::kWireframe);
+  // The materials colour the picture: somewhere a red pixel (the red wall) and a green one.
+  const Image& image = played.at(0).image;
+  bool red = false;
+  bool green = false;
+  for (std::uint32_t y = 0; y < image.height; ++y) {
+    for (std::uint32_t x = 0; x < image.width; ++x) {
+      const int r = image.at(x, y, 0), g = image.at(x, y, 1), b = image.at(x, y, 2);
+      red = red || (r > 80 && g < r / 3 && b < r / 3);
+      green = green || (g > 80 && r < g / 3 && b < g / 3);
+    }
+  }
+  EXPECT_TRUE(red) << "no pixel of the red wall";
+  EXPECT_TRUE(green) << "no pixel of the green wall";
+  EXPECT_FALSE(played.at(0).image.pixels == played.at(1).image.pixels) << "the wireframe wall changes the picture";
+}
+
 }  // namespace
 }  // namespace basalt::script
