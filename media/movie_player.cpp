@@ -272,41 +272,36 @@ Result<std::unique_ptr<Clip>> MoviePlayer::Impl::openClip(std::size_t entry, boo
   clip->entry = entry;
   clip->audio = options.audio;
   clip->name = options.name;
-  std::error_code ec;
-  const std::filesystem::path absolute = std::filesystem::absolute(clip->path, ec);
-  GError* uriError = nullptr;
-  gchar* uri = gst_filename_to_uri(absolute.c_str(), &uriError);
-  if (!uri) {
-    if (uriError) g_error_free(uriError);
-    return fail(Errc::kInvalidArgument, "cannot make a URI of this path", clip->path.string());
-  }
-  if (auto r = ensureGstreamer(); !r) {
-    g_free(uri);
-    return std::unexpected(r.error());
-  }
-  // uridecodebin (typefind, demuxer, parser, decoder) is linked by hand in onPadAdded, so that
-  // sound and other streams are routed and unsupported codecs reported.
+  if (auto r = ensureGstreamer(); !r) return std::unexpected(r.error());
+  // filesrc ! queue ! decodebin, linked by hand in onPadAdded so that sound and other streams
+  // are routed and unsupported codecs reported. The queue puts the demuxer in push mode: in pull
+  // mode decodebin can swallow a demuxer's error raised while it is still being set up (a
+  // damaged file then never prerolls and never says why).
   GstElement* pipeline = gst_pipeline_new(nullptr);
-  GstElement* dec = gst_element_factory_make("uridecodebin", "dec");
+  GstElement* src = gst_element_factory_make("filesrc", nullptr);
+  GstElement* pushQueue = gst_element_factory_make("queue", nullptr);
+  GstElement* dec = gst_element_factory_make("decodebin", "dec");
   GError* parseError = nullptr;
   const std::string tailDescription = fmt::format("videoconvert ! {} ! appsink name=sink", uploadableFormatsCaps());
   GstElement* tail = gst_parse_bin_from_description(tailDescription.c_str(), TRUE, &parseError);
-  if (!pipeline || !dec || !tail) {
+  if (!pipeline || !src || !pushQueue || !dec || !tail) {
     if (parseError) g_error_free(parseError);
-    g_free(uri);
-    if (pipeline) gst_object_unref(pipeline);
+    for (GstElement* e : {pipeline, src, pushQueue, dec, tail}) {
+      if (e) gst_object_unref(gst_object_ref_sink(e));
+    }
     return fail(Errc::kUnsupported,
-                "GStreamer lacks uridecodebin, videoconvert or appsink; install gstreamer1.0-plugins-base",
+                "GStreamer lacks filesrc, queue, decodebin, videoconvert or appsink; install "
+                "gstreamer1.0-plugins-base",
                 clip->path.string());
   }
   gst_object_ref_sink(pipeline);
   clip->pipeline = Pipeline(pipeline);
-  gst_bin_add_many(reinterpret_cast<GstBin*>(pipeline), dec, tail, nullptr);
+  gst_bin_add_many(reinterpret_cast<GstBin*>(pipeline), src, pushQueue, dec, tail, nullptr);
+  gst_element_link_many(src, pushQueue, dec, nullptr);
   clip->convert = tail;
   clip->sink = gst_bin_get_by_name(reinterpret_cast<GstBin*>(tail), "sink");
   gst_object_unref(clip->sink);  // the bin keeps it alive
-  g_object_set(dec, "uri", uri, nullptr);
-  g_free(uri);
+  g_object_set(src, "location", clip->path.c_str(), nullptr);
   g_object_set(clip->sink, "sync", FALSE, "max-buffers", 2U, "drop", FALSE, "emit-signals", FALSE, "enable-last-sample",
                FALSE, nullptr);
   g_signal_connect(dec, "pad-added", G_CALLBACK(onPadAdded), clip.get());
