@@ -361,6 +361,11 @@ Result<void> MoviePlayer::Impl::finishOpen(Clip& clip, std::chrono::milliseconds
                   where);
     }
     if (m && GST_MESSAGE_TYPE(m.get()) == GST_MESSAGE_ASYNC_DONE) break;
+    GstState now = GST_STATE_VOID_PENDING;
+    if (gst_element_get_state(clip.pipeline.get(), &now, nullptr, 0) == GST_STATE_CHANGE_SUCCESS &&
+        now >= GST_STATE_PAUSED) {
+      break;  // prerolled while nobody was reading the bus
+    }
     if (clock.now() > deadline) {
       return fail(Errc::kTimeout, fmt::format("the movie did not open within {} s", timeout.count() / 1000), where);
     }
@@ -693,15 +698,6 @@ void MoviePlayer::Impl::run() {
     }
     if (!current || clipEnded) continue;
     if (!pollBus(*current)) continue;
-    if (next && !next->prerolled) {
-      BusPtr bus(gst_element_get_bus(next->pipeline.get()));
-      MessagePtr m(gst_bus_pop_filtered(bus.get(), GST_MESSAGE_ERROR));
-      if (m) {
-        setFailed(Error(Errc::kUnsupported, fmt::format("cannot play the movie: {}", describeGstMessage(m.get())),
-                        next->path.string()));
-        continue;
-      }
-    }
     if (!queue.waitForRoom(kPoll)) continue;
     SamplePtr sample(gst_app_sink_try_pull_sample(reinterpret_cast<GstAppSink*>(current->sink),
                                                   static_cast<GstClockTime>(std::chrono::nanoseconds(kPoll).count())));
@@ -844,8 +840,15 @@ void MoviePlayer::requestSeek(std::int64_t index) {
 }
 
 void MoviePlayer::anchorAtShown() {
+  // The press happened while the shown frame was on screen: time runs from that frame's show
+  // time, so the next frame comes one frame later.
   anchorPts_ = shownPts_;
-  needShowAnchor_ = true;
+  if (shownIndex_ >= 0) {
+    anchorShow_ = lastShowTime_;
+    needShowAnchor_ = false;
+  } else {
+    needShowAnchor_ = true;
+  }
 }
 
 void MoviePlayer::play() { shuttle(1.0); }
@@ -899,8 +902,11 @@ void MoviePlayer::shuttle(double speed) {
   }
   transport_ = Transport::kPlaying;
   speed_ = speed;
-  if (speed < 0) reverseAnchorIndex_ = logicalIndex();
   anchorAtShown();
+  if (speed < 0) {
+    reverseAnchorIndex_ = logicalIndex();
+    reverseAnchorShow_ = lastShowTime_;
+  }
   // Play at the end of a clip that does not repeat starts it again, as a VCR would.
   if (ended && speed > 0 && !awaitFirst_ && impl_->queue.size() == 0) requestSeek(0);
 }
@@ -920,17 +926,21 @@ void MoviePlayer::seekTime(Nanos time) {
 Nanos MoviePlayer::targetTime(Nanos showTime) const {
   if (awaitFirst_ || needShowAnchor_ || transport_ != Transport::kPlaying || speed_ < 0) return anchorPts_;
   const double elapsed = static_cast<double>((showTime - anchorShow_).count()) * speed_;
-  return anchorPts_ + Nanos{static_cast<std::int64_t>(elapsed)};
+  // Containers round timestamps (Matroska and most MP4s to the millisecond): a frame stamped
+  // up to this much after the target is the frame the target means, not an early one.
+  constexpr Nanos kTimestampRounding = std::chrono::microseconds(1500);
+  return anchorPts_ + Nanos{static_cast<std::int64_t>(elapsed)} + kTimestampRounding;
 }
 
 FrameRef MoviePlayer::frameAt(Nanos showTime) {
+  lastShowTime_ = showTime;
   if (needShowAnchor_ && !awaitFirst_) {
     anchorShow_ = showTime;
     needShowAnchor_ = false;
   }
-  if (transport_ == Transport::kPlaying && speed_ < 0 && !awaitFirst_ && !needShowAnchor_) {
+  if (transport_ == Transport::kPlaying && speed_ < 0 && !awaitFirst_) {
     // Reverse shuttle: one accurate seek to the frame the clock asks for.
-    const double back = toSeconds(showTime - anchorShow_) * -speed_ / toSeconds(frameDuration());
+    const double back = toSeconds(showTime - reverseAnchorShow_) * -speed_ / toSeconds(frameDuration());
     std::int64_t target = reverseAnchorIndex_ - static_cast<std::int64_t>(std::floor(back + 1e-9));
     if (target < 0) target = 0;
     if (target != shownIndex_) requestSeek(target);

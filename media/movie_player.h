@@ -159,6 +159,8 @@ class MoviePlayer final : public FrameSource {
   Nanos anchorShow_{0};          // show time at which the timeline was at anchorPts_
   Nanos anchorPts_{0};           // timeline position
   std::int64_t reverseAnchorIndex_ = 0;
+  Nanos reverseAnchorShow_{0};
+  Nanos lastShowTime_{0};          // the show time of the last frameAt()
   std::int64_t pendingIndex_ = 0;  // the frame a pending seek goes to
   std::int64_t shownIndex_ = -1;
   std::size_t shownClip_ = 0;

@@ -21,7 +21,8 @@ Image numberedImage(std::uint32_t width, std::uint32_t height, int number) {
 }
 
 Result<std::filesystem::path> makeNumberedClip(const std::filesystem::path& path, int frames, double fps,
-                                               media::VideoCodec codec, std::uint32_t width, std::uint32_t height) {
+                                               media::VideoCodec codec, std::uint32_t width, std::uint32_t height,
+                                               int firstNumber) {
   std::error_code ec;
   if (std::filesystem::exists(path, ec)) return path;
   const std::filesystem::path partial = path.parent_path() / ("partial-" + path.filename().string());
@@ -35,7 +36,8 @@ Result<std::filesystem::path> makeNumberedClip(const std::filesystem::path& path
   auto recorder = media::Recorder::create(o);
   if (!recorder) return std::unexpected(recorder.error());
   for (int n = 0; n < frames; ++n) {
-    if (auto r = (*recorder)->push(numberedImage(width, height, n)); !r) return std::unexpected(r.error());
+    if (auto r = (*recorder)->push(numberedImage(width, height, firstNumber + n)); !r)
+      return std::unexpected(r.error());
   }
   if (auto r = (*recorder)->finish(); !r) return std::unexpected(r.error());
   std::filesystem::rename(partial, path, ec);

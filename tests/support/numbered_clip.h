@@ -20,11 +20,11 @@ constexpr int kNumberBits = 10;
 /// \brief An RGBA image showing `number` as bars (and a colour that changes with it).
 Image numberedImage(std::uint32_t width, std::uint32_t height, int number);
 
-/// \brief Writes a clip of `frames` numbered frames at `fps` with `codec` to `path` (the
+/// \brief Writes a clip of `frames` frames numbered from `firstNumber` at `fps` with `codec` to `path` (the
 /// container from the extension), unless it exists already from an earlier test.
 Result<std::filesystem::path> makeNumberedClip(const std::filesystem::path& path, int frames, double fps,
                                                media::VideoCodec codec, std::uint32_t width = 160,
-                                               std::uint32_t height = 120);
+                                               std::uint32_t height = 120, int firstNumber = 0);
 
 /// \brief The number a decoded frame shows (I420, YV12, NV12, NV21, YUYV, UYVY, RGBA, BGRA,
 /// GRAY8), or -1 when the format is not readable here.
