@@ -11,7 +11,7 @@
 
 BUILD ?= build
 BUILD_TYPE ?= RelWithDebInfo
-RUN_ARGS ?= --seconds 10
+RUN_ARGS ?= --seconds 10 --record out/default_show.mp4
 CMAKE_ARGS ?=
 FUZZ_SECONDS ?= 60
 
