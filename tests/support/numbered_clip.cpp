@@ -1,5 +1,8 @@
 #include "support/numbered_clip.h"
 
+#include <unistd.h>
+
+#include <string>
 #include <system_error>
 
 namespace basalt::test {
@@ -25,7 +28,9 @@ Result<std::filesystem::path> makeNumberedClip(const std::filesystem::path& path
                                                int firstNumber) {
   std::error_code ec;
   if (std::filesystem::exists(path, ec)) return path;
-  const std::filesystem::path partial = path.parent_path() / ("partial-" + path.filename().string());
+  // Test cases run as parallel processes: each writes its own partial file, then renames it.
+  const std::filesystem::path partial =
+      path.parent_path() / ("partial-" + std::to_string(::getpid()) + "-" + path.filename().string());
   media::RecorderOptions o;
   o.path = partial;
   o.width = width;
