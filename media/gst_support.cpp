@@ -71,11 +71,12 @@ std::string describeGstMessage(GstMessage* message) {
   }
   std::string text = error ? error->message : "unknown GStreamer error";
   if (debug && *debug) {
-    std::string_view d = debug;
-    // The last line of the debug text names the element and the reason; keep it short.
-    const auto colon = d.rfind(":\n");
-    if (colon != std::string_view::npos) d = d.substr(colon + 2);
-    text += fmt::format(" ({})", d);
+    // GStreamer's debug text is "file.c(line): function (): /element/path:\nreason"; only the
+    // reason helps a person, and only when there is one.
+    const std::string_view d = debug;
+    const auto newline = d.rfind('\n');
+    if (newline != std::string_view::npos && newline + 1 < d.size())
+      text += fmt::format(" ({})", d.substr(newline + 1));
   }
   if (error) g_error_free(error);
   g_free(debug);
