@@ -158,6 +158,44 @@ Colorimetry fromGstColorimetry(const GstVideoColorimetry& colorimetry) {
   return c;
 }
 
+FrameRef wrapVideoBuffer(GstBuffer* buffer, const GstVideoInfo& info, FramePool& pool, VideoFrameSlot* slots,
+                         std::size_t slotCount) {
+  FrameRef frame = pool.acquire();
+  if (!frame) return {};
+  VideoFrameSlot* slot = nullptr;
+  for (std::size_t i = 0; i < slotCount && !slot; ++i) {
+    bool expected = false;
+    if (slots[i].inUse.compare_exchange_strong(expected, true)) slot = &slots[i];
+  }
+  if (!slot) return {};
+  if (!gst_video_frame_map(&slot->frame, &info, buffer, GST_MAP_READ)) {
+    slot->inUse = false;
+    return {};
+  }
+  Frame& f = *frame;
+  f.format = fromGstFormat(GST_VIDEO_INFO_FORMAT(&info));
+  f.width = static_cast<std::uint32_t>(GST_VIDEO_INFO_WIDTH(&info));
+  f.height = static_cast<std::uint32_t>(GST_VIDEO_INFO_HEIGHT(&info));
+  f.planeCount = static_cast<int>(GST_VIDEO_FRAME_N_PLANES(&slot->frame));
+  for (int p = 0; p < f.planeCount && p < 4; ++p) {
+    Plane& plane = f.planes[static_cast<std::size_t>(p)];
+    plane.data = static_cast<std::uint8_t*>(GST_VIDEO_FRAME_PLANE_DATA(&slot->frame, p));
+    plane.stride = static_cast<std::uint32_t>(GST_VIDEO_FRAME_PLANE_STRIDE(&slot->frame, p));
+    plane.offset = 0;
+    plane.size = std::size_t{plane.stride} * static_cast<std::uint32_t>(GST_VIDEO_FRAME_COMP_HEIGHT(&slot->frame, p));
+    plane.dmabufFd = -1;
+  }
+  f.colorimetry = fromGstColorimetry(info.colorimetry);
+  f.setRelease(
+      [](void* context, Frame&) {
+        auto* s = static_cast<VideoFrameSlot*>(context);
+        gst_video_frame_unmap(&s->frame);
+        s->inUse.store(false, std::memory_order_release);
+      },
+      slot);
+  return frame;
+}
+
 std::string_view uploadableFormatsCaps() {
   return "video/x-raw,format=(string){I420,YV12,NV12,NV21,YUY2,UYVY,RGBA,BGRA,GRAY8}";
 }

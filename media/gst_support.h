@@ -10,6 +10,7 @@
 #include <gst/gst.h>
 #include <gst/video/video.h>
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -115,6 +116,19 @@ Colorimetry fromGstColorimetry(const GstVideoColorimetry& colorimetry);
 
 /// \brief The caps string of every raw format the renderer uploads without conversion.
 std::string_view uploadableFormatsCaps();
+
+/// \brief A Frame's hold on a mapped GStreamer video buffer, released by the Frame's release hook
+/// (from whichever thread drops the last reference).
+struct VideoFrameSlot {
+  GstVideoFrame frame{};
+  std::atomic<bool> inUse{false};  // set by the producer, cleared by the release hook
+};
+
+/// \brief Wraps a decoded buffer as a pooled Frame without copying: maps it (keeping a reference)
+/// into a free slot and fills format, size and planes. Empty when no frame or slot is free (the
+/// renderer still holds them) or the buffer cannot be mapped.
+FrameRef wrapVideoBuffer(GstBuffer* buffer, const GstVideoInfo& info, FramePool& pool, VideoFrameSlot* slots,
+                         std::size_t slotCount);
 
 /// \brief Nanoseconds from a GstClockTime (GST_CLOCK_TIME_NONE becomes -1).
 inline Nanos fromGstTime(GstClockTime t) {

@@ -169,18 +169,12 @@ gboolean onAutoplugContinue(GstElement*, GstPad*, GstCaps* caps, gpointer data) 
 
 }  // namespace
 
-/// A frame's hold on a decoded GStreamer buffer, released by the Frame's release hook.
-struct FrameSlot {
-  GstVideoFrame frame{};
-  std::atomic<bool> inUse{false};  // set by the decoder thread, cleared by the release hook
-};
-
 struct MoviePlayer::Impl {
   explicit Impl(MoviePlayerOptions o)
       : options(std::move(o)),
         queue(options.queueFrames),
         poolSize(options.queueFrames + 4),
-        slots(std::make_unique<FrameSlot[]>(poolSize)) {
+        slots(std::make_unique<VideoFrameSlot[]>(poolSize)) {
     FramePool::Config config;
     config.format = PixelFormat::kUnknown;
     config.count = poolSize;
@@ -192,7 +186,7 @@ struct MoviePlayer::Impl {
   FrameQueue queue;
   std::size_t poolSize;
   std::shared_ptr<FramePool> pool;
-  std::unique_ptr<FrameSlot[]> slots;
+  std::unique_ptr<VideoFrameSlot[]> slots;
   std::thread worker;
 
   struct Command {
@@ -449,49 +443,15 @@ void MoviePlayer::Impl::deliver(GstSample* sample) {
   if (lastPts.count() >= 0 && timeline <= lastPts) timeline = lastPts + Nanos{1};  // keep the queue ordered
 
   FrameRef frame;
-  FrameSlot* slot = nullptr;
   for (int attempt = 0; attempt < 500 && !frame; ++attempt) {
-    frame = pool->acquire();
+    frame = wrapVideoBuffer(buffer, clip.videoInfo, *pool, slots.get(), poolSize);
     if (!frame) std::this_thread::sleep_for(std::chrono::milliseconds(2));  // the renderer still holds frames
   }
   if (!frame) return;
-  for (std::size_t i = 0; i < poolSize; ++i) {
-    bool expected = false;
-    if (slots[i].inUse.compare_exchange_strong(expected, true)) {
-      slot = &slots[i];
-      break;
-    }
-  }
-  if (!slot) return;  // cannot happen: there are as many slots as frames
-  if (!gst_video_frame_map(&slot->frame, &clip.videoInfo, buffer, GST_MAP_READ)) {
-    slot->inUse = false;
-    return;
-  }
   Frame& f = *frame;
-  f.format = fromGstFormat(GST_VIDEO_INFO_FORMAT(&clip.videoInfo));
-  f.width = static_cast<std::uint32_t>(GST_VIDEO_INFO_WIDTH(&clip.videoInfo));
-  f.height = static_cast<std::uint32_t>(GST_VIDEO_INFO_HEIGHT(&clip.videoInfo));
-  f.planeCount = static_cast<int>(GST_VIDEO_FRAME_N_PLANES(&slot->frame));
-  for (int p = 0; p < f.planeCount && p < 4; ++p) {
-    Plane& plane = f.planes[static_cast<std::size_t>(p)];
-    plane.data = static_cast<std::uint8_t*>(GST_VIDEO_FRAME_PLANE_DATA(&slot->frame, p));
-    plane.stride = static_cast<std::uint32_t>(GST_VIDEO_FRAME_PLANE_STRIDE(&slot->frame, p));
-    plane.offset = 0;
-    const std::uint32_t rows = static_cast<std::uint32_t>(GST_VIDEO_FRAME_COMP_HEIGHT(&slot->frame, p));
-    plane.size = std::size_t{plane.stride} * rows;
-    plane.dmabufFd = -1;
-  }
   f.pts = timeline;
   f.sequence = static_cast<std::uint64_t>(index);
-  f.colorimetry = fromGstColorimetry(clip.videoInfo.colorimetry);
   f.producerCookie = (generation << 16) | (clip.entry & 0xffff);
-  f.setRelease(
-      [](void* context, Frame&) {
-        auto* s = static_cast<FrameSlot*>(context);
-        gst_video_frame_unmap(&s->frame);
-        s->inUse.store(false, std::memory_order_release);
-      },
-      slot);
   lastPts = timeline;
   lastIndex = index;
   decoded.fetch_add(1, std::memory_order_relaxed);
