@@ -276,7 +276,11 @@ Result<std::unique_ptr<Clip>> MoviePlayer::Impl::openClip(std::size_t entry, boo
   GstElement* pushQueue = gst_element_factory_make("queue", nullptr);
   GstElement* dec = gst_element_factory_make("decodebin", "dec");
   GError* parseError = nullptr;
-  const std::string tailDescription = fmt::format("videoconvert ! {} ! appsink name=sink", uploadableFormatsCaps());
+  const std::string formats =
+      options.cpuConvertTo == PixelFormat::kUnknown
+          ? std::string(uploadableFormatsCaps())
+          : fmt::format("video/x-raw,format={}", gst_video_format_to_string(toGstFormat(options.cpuConvertTo)));
+  const std::string tailDescription = fmt::format("videoconvert ! {} ! appsink name=sink", formats);
   GstElement* tail = gst_parse_bin_from_description(tailDescription.c_str(), TRUE, &parseError);
   if (!pipeline || !src || !pushQueue || !dec || !tail) {
     if (parseError) g_error_free(parseError);

@@ -55,6 +55,10 @@ struct MoviePlayerOptions {
   std::size_t queueFrames = 8;  ///< decoded frames kept ahead of the show (the gapless margin)
   bool audio = false;           ///< play sound on the default output; discarded when false or absent
   std::string name = "movie";   ///< for messages: the part or stream it feeds
+  /// Converts every frame to this format on the CPU (videoconvert) instead of handing the
+  /// decoder's planes on: only for comparisons (the naive path in the benchmarks). kUnknown
+  /// (the default) keeps the decoder's format.
+  PixelFormat cpuConvertTo = PixelFormat::kUnknown;
 };
 
 /// \brief Counters for the status server and tests.

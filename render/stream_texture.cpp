@@ -125,12 +125,42 @@ void setSampling(GLenum filter) {
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 }
 
+/// The conversion program for one layout.
+struct ConversionProgram {
+  gl::Program program;
+  GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1;
+};
+
+/// yuv.frag with LAYOUT defined: one program per layout, so no pixel runs a branch.
+Result<ConversionProgram> buildConversion(int layout) {
+  std::string_view text = shaders::kYuvFrag;
+  const auto firstLine = text.find('\n');
+  const std::string source =
+      fmt::format("{}\n#define LAYOUT {}\n{}", text.substr(0, firstLine), layout, text.substr(firstLine + 1));
+  auto program = gl::buildProgram(shaders::kQuadVert, source, fmt::format("yuv layout {}", layout));
+  if (!program) return std::unexpected(program.error());
+  ConversionProgram c;
+  c.program = std::move(*program);
+  const GLuint p = c.program.id();
+  c.yCoef = glGetUniformLocation(p, "uYCoef");
+  c.uCoef = glGetUniformLocation(p, "uUCoef");
+  c.vCoef = glGetUniformLocation(p, "uVCoef");
+  c.bias = glGetUniformLocation(p, "uBias");
+  c.rect = glGetUniformLocation(p, "uRect");
+  c.flip = glGetUniformLocation(p, "uFlipY");
+  glUseProgram(p);
+  glUniform1i(glGetUniformLocation(p, "uPlane0"), 0);
+  glUniform1i(glGetUniformLocation(p, "uPlane1"), 1);
+  glUniform1i(glGetUniformLocation(p, "uPlane2"), 2);
+  glUseProgram(0);
+  return c;
+}
+
 }  // namespace
 
 struct StreamTexture::Gpu {
-  gl::Program program;
-  GLint layout = -1, matrix = -1, offset = -1, rect = -1, flip = -1;
-  gl::VertexArray vao;  // attributeless draws still need a bound VAO in ES 3
+  std::array<ConversionProgram, 8> programs;  // by layout, built on first use
+  gl::VertexArray vao;                        // attributeless draws still need a bound VAO in ES 3
   std::array<gl::Texture, 3> planes;
   std::array<PlaneFormat, 3> planeFormat{};
   int planeCount = 0;
@@ -148,21 +178,11 @@ StreamTexture::~StreamTexture() = default;
 
 Result<std::unique_ptr<StreamTexture>> StreamTexture::create(std::string name) {
   std::unique_ptr<StreamTexture> s(new StreamTexture(std::move(name)));
-  auto program = gl::buildProgram(shaders::kQuadVert, shaders::kYuvFrag, "yuv");
-  if (!program) return std::unexpected(program.error());
   Gpu& g = *s->gpu_;
-  g.program = std::move(*program);
-  const GLuint p = g.program.id();
-  g.layout = glGetUniformLocation(p, "uLayout");
-  g.matrix = glGetUniformLocation(p, "uYuvToRgb");
-  g.offset = glGetUniformLocation(p, "uOffset");
-  g.rect = glGetUniformLocation(p, "uRect");
-  g.flip = glGetUniformLocation(p, "uFlipY");
-  glUseProgram(p);
-  glUniform1i(glGetUniformLocation(p, "uPlane0"), 0);
-  glUniform1i(glGetUniformLocation(p, "uPlane1"), 1);
-  glUniform1i(glGetUniformLocation(p, "uPlane2"), 2);
-  glUseProgram(0);
+  // The common decoder layout is built now, so that a broken shader fails at start-up.
+  auto i420 = buildConversion(kThreePlanes);
+  if (!i420) return std::unexpected(i420.error());
+  g.programs[kThreePlanes] = std::move(*i420);
   g.vao = gl::VertexArray::create();
   const EGLDisplay display = eglGetCurrentDisplay();
   const char* extensions = display != EGL_NO_DISPLAY ? eglQueryString(display, EGL_EXTENSIONS) : nullptr;
@@ -279,6 +299,21 @@ Result<void> StreamTexture::uploadPlanes(const Frame& frame) {
   return {};
 }
 
+Result<void> StreamTexture::uploadRgba(const Frame& frame) {
+  const Plane& plane = frame.planes[0];
+  if (!plane.data || plane.stride % 4 != 0) {
+    return fail(Errc::kUnsupported, fmt::format("stream '{}': an RGBA frame without mapped rows", name_));
+  }
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, static_cast<GLint>(plane.stride / 4));
+  glBindTexture(GL_TEXTURE_2D, gpu_->target.id());
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, static_cast<GLsizei>(frame.width), static_cast<GLsizei>(frame.height),
+                  GL_RGBA, GL_UNSIGNED_BYTE, plane.data);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  return {};
+}
+
 Result<void> StreamTexture::importDmabuf(const Frame& frame) {
   // Planes are imported as separate R8/RG88 images (what Mesa and most drivers take) and run
   // through the same conversion shader as uploaded planes.
@@ -326,22 +361,33 @@ Result<void> StreamTexture::importDmabuf(const Frame& frame) {
   return {};
 }
 
-void StreamTexture::convert(const Frame& frame) {
+Result<void> StreamTexture::convert(const Frame& frame) {
   Gpu& g = *gpu_;
+  const int layout = layoutOf(frame.format);
+  ConversionProgram& c = g.programs[static_cast<std::size_t>(layout)];
+  if (!c.program) {
+    auto built = buildConversion(layout);
+    if (!built) return std::unexpected(built.error());
+    c = std::move(*built);
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, g.fbo.id());
   glViewport(0, 0, static_cast<GLsizei>(g.width), static_cast<GLsizei>(g.height));
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
-  glUseProgram(g.program.id());
-  glUniform1i(g.layout, layoutOf(frame.format));
+  glUseProgram(c.program.id());
   std::array<float, 9> m{};
   std::array<float, 3> offset{};
   colorMatrix(frame.colorimetry, m, offset);
-  glUniformMatrix3fv(g.matrix, 1, GL_FALSE, m.data());
-  glUniform3f(g.offset, offset[0], offset[1], offset[2]);
-  glUniform4f(g.rect, -1.0f, -1.0f, 1.0f, 1.0f);
-  glUniform1i(g.flip, 0);
+  // Columns of m are the Y, U and V contributions; the bias is -m * offset.
+  glUniform3f(c.yCoef, m[0], m[1], m[2]);
+  glUniform3f(c.uCoef, m[3], m[4], m[5]);
+  glUniform3f(c.vCoef, m[6], m[7], m[8]);
+  glUniform3f(c.bias, -(m[0] * offset[0] + m[3] * offset[1] + m[6] * offset[2]),
+              -(m[1] * offset[0] + m[4] * offset[1] + m[7] * offset[2]),
+              -(m[2] * offset[0] + m[5] * offset[1] + m[8] * offset[2]));
+  glUniform4f(c.rect, -1.0f, -1.0f, 1.0f, 1.0f);
+  glUniform1i(c.flip, 0);
   // YV12 stores V before U: bind the planes so that unit 1 is always U.
   const bool swapUv = frame.format == PixelFormat::kYv12;
   for (int i = 0; i < 3; ++i) {
@@ -359,6 +405,7 @@ void StreamTexture::convert(const Frame& frame) {
   }
   glUseProgram(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return {};
 }
 
 Result<bool> StreamTexture::update(const FrameRef& ref) {
@@ -383,10 +430,15 @@ Result<bool> StreamTexture::update(const FrameRef& ref) {
       dmabufOffered_ = false;
     }
   }
-  if (path == UploadPath::kPlanes) {
-    if (auto r = uploadPlanes(frame); !r) return std::unexpected(r.error());
+  if (path == UploadPath::kPlanes && frame.format == PixelFormat::kRgba8) {
+    // Already what the renderer samples: straight into the target, no pass.
+    if (auto r = uploadRgba(frame); !r) return std::unexpected(r.error());
+  } else {
+    if (path == UploadPath::kPlanes) {
+      if (auto r = uploadPlanes(frame); !r) return std::unexpected(r.error());
+    }
+    if (auto r = convert(frame); !r) return std::unexpected(r.error());
   }
-  convert(frame);
   if (path != path_ || frame.format != format_ || !(frame.colorimetry == colorimetry_)) {
     path_ = path;
     format_ = frame.format;
@@ -413,8 +465,10 @@ void StreamTexture::publish(TextureRegistry& registry) const { registry.setExter
 std::string StreamTexture::describe() const {
   if (path_ == UploadPath::kNone) return fmt::format("stream '{}': no frame yet (fallback shown)", name_);
   const bool yuv = isYuv(format_);
-  return fmt::format("stream '{}': {} {}x{}, {}{}", name_, pixelFormatName(format_), gpu_->width, gpu_->height,
-                     uploadPathName(path_),
+  const std::string_view how = path_ == UploadPath::kPlanes && format_ == PixelFormat::kRgba8
+                                   ? std::string_view("uploaded as is (already RGBA)")
+                                   : uploadPathName(path_);
+  return fmt::format("stream '{}': {} {}x{}, {}{}", name_, pixelFormatName(format_), gpu_->width, gpu_->height, how,
                      yuv ? fmt::format(" ({} {} range)", matrixName(colorimetry_),
                                        colorimetry_.range == Colorimetry::Range::kFull ? "full" : "limited")
                          : std::string{});

@@ -72,7 +72,8 @@ class StreamTexture {
   Result<void> ensureTarget(std::uint32_t width, std::uint32_t height);
   Result<void> uploadPlanes(const Frame& frame);
   Result<void> importDmabuf(const Frame& frame);
-  void convert(const Frame& frame);
+  Result<void> uploadRgba(const Frame& frame);
+  Result<void> convert(const Frame& frame);
 
   std::string name_;
   std::unique_ptr<Gpu> gpu_;
