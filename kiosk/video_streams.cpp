@@ -1,6 +1,7 @@
 #include "kiosk/video_streams.h"
 
 #include <charconv>
+#include <cmath>
 
 #include <fmt/format.h>
 #include <fmt/std.h>
@@ -37,7 +38,7 @@ Result<std::pair<std::string, ZoomSpec>> parseZoomOption(std::string_view text) 
     name = std::string(rest.substr(0, eq));
     const std::string_view s = rest.substr(eq + 1);
     const auto r = std::from_chars(s.data(), s.data() + s.size(), zoom.scale);
-    if (r.ec != std::errc{} || r.ptr != s.data() + s.size() || zoom.scale <= 0 || zoom.scale > 16) return bad();
+    if (r.ec != std::errc{} || r.ptr != s.data() + s.size() || !(zoom.scale > 0 && zoom.scale <= 16)) return bad();
   }
   if (!at.empty()) {
     const auto comma = at.find(',');
@@ -46,7 +47,7 @@ Result<std::pair<std::string, ZoomSpec>> parseZoomOption(std::string_view text) 
     const auto rx = std::from_chars(xs.data(), xs.data() + xs.size(), zoom.x);
     const auto ry = std::from_chars(ys.data(), ys.data() + ys.size(), zoom.y);
     if (rx.ec != std::errc{} || ry.ec != std::errc{} || rx.ptr != xs.data() + xs.size() ||
-        ry.ptr != ys.data() + ys.size()) {
+        ry.ptr != ys.data() + ys.size() || !std::isfinite(zoom.x) || !std::isfinite(zoom.y)) {
       return bad();
     }
   }
