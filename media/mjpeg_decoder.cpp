@@ -54,7 +54,7 @@ struct MjpegDecoder::Impl {
   std::condition_variable decodedCv;
   std::array<Stamp, 32> stamps{};  // guarded by mutex
   std::size_t nextStamp = 0;       // guarded by mutex
-  GstCaps* lastCaps = nullptr;     // streaming thread only; identity, never dereferenced
+  CapsPtr lastCaps;                // streaming thread only; held so that its address stays its own
   GstVideoInfo info{};             // streaming thread only
   std::atomic<std::uint64_t> decoded{0};
   std::atomic<std::uint64_t> dropped{0};
@@ -66,9 +66,9 @@ struct MjpegDecoder::Impl {
     GstBuffer* buffer = gst_sample_get_buffer(sample.get());
     GstCaps* caps = gst_sample_get_caps(sample.get());
     if (!buffer || !caps) return GST_FLOW_OK;
-    if (caps != lastCaps) {
+    if (caps != lastCaps.get()) {
       if (!gst_video_info_from_caps(&info, caps)) return GST_FLOW_OK;
-      lastCaps = caps;
+      lastCaps.reset(gst_caps_ref(caps));
     }
     FrameRef frame = wrapVideoBuffer(buffer, info, *pool, slots.get(), poolSize);
     if (!frame) {

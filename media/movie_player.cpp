@@ -77,6 +77,12 @@ std::string codecDescription(const GstCaps* caps) {
 /// its frames go on the timeline. Owned by the decoder thread; the callbacks' fields are
 /// guarded by `mutex`.
 struct Clip {
+  Clip() = default;
+  Clip(const Clip&) = delete;
+  Clip& operator=(const Clip&) = delete;
+  // The pipeline stops first: its streaming threads call back into the fields below.
+  ~Clip() { pipeline.reset(); }
+
   std::filesystem::path path;
   std::size_t entry = 0;
   Pipeline pipeline;
@@ -95,8 +101,8 @@ struct Clip {
   // Decoder thread only:
   bool prerolled = false;
   MovieInfo info;
-  Nanos start{-1};              // stream pts of frame 0
-  GstCaps* lastCaps = nullptr;  // identity only, never dereferenced
+  Nanos start{-1};   // stream pts of frame 0
+  CapsPtr lastCaps;  // held, so that a new caps cannot reuse its address
   GstVideoInfo videoInfo{};
 };
 
@@ -427,9 +433,9 @@ void MoviePlayer::Impl::deliver(GstSample* sample) {
   GstBuffer* buffer = gst_sample_get_buffer(sample);
   GstCaps* caps = gst_sample_get_caps(sample);
   if (!buffer || !caps) return;
-  if (caps != clip.lastCaps) {
+  if (caps != clip.lastCaps.get()) {
     if (!gst_video_info_from_caps(&clip.videoInfo, caps)) return;
-    clip.lastCaps = caps;
+    clip.lastCaps.reset(gst_caps_ref(caps));
   }
   const Nanos dur = clip.info.frameDuration;
   Nanos pts = fromGstTime(GST_BUFFER_PTS(buffer));

@@ -207,15 +207,24 @@ Result<std::unique_ptr<Recorder>> Recorder::create(const RecorderOptions& option
   return recorder;
 }
 
+namespace {
+
+/// One message for a failed recording: GStreamer's reason and what to do.
+Error recordingError(GstMessage* message, const std::filesystem::path& path) {
+  const std::string why = describeGstMessage(message);
+  const std::string_view advice = why.find("space") != std::string::npos ? "free some disk space or record elsewhere"
+                                                                         : "check the folder and the disk";
+  return Error(Errc::kIo, fmt::format("recording failed: {}; {}", why, advice), path.string());
+}
+
+}  // namespace
+
 Result<void> Recorder::checkBus() {
   if (failure_) return std::unexpected(*failure_);
   BusPtr bus(gst_element_get_bus(impl_->pipeline.get()));
   MessagePtr m(gst_bus_pop_filtered(bus.get(), GST_MESSAGE_ERROR));
   if (!m) return {};
-  std::string why = describeGstMessage(m.get());
-  std::string advice = "check the folder and the disk";
-  if (why.find("space") != std::string::npos) advice = "free some disk space or record elsewhere";
-  failure_ = Error(Errc::kIo, fmt::format("recording failed: {}; {}", why, advice), options_.path.string());
+  failure_ = recordingError(m.get(), options_.path);
   return std::unexpected(*failure_);
 }
 
@@ -277,9 +286,7 @@ Result<void> Recorder::finish(std::chrono::milliseconds timeout) {
     if (!m) {
       failure_ = Error(Errc::kTimeout, "the encoder did not finish the file in time", options_.path.string());
     } else if (GST_MESSAGE_TYPE(m.get()) == GST_MESSAGE_ERROR) {
-      gst_bus_post(bus.get(), gst_message_ref(m.get()));  // let checkBus() phrase it
-      failure_.reset();
-      (void)checkBus();
+      failure_ = recordingError(m.get(), options_.path);
     }
   }
   impl_->pipeline.reset();

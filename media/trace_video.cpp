@@ -182,7 +182,6 @@ struct TraceVideoReader::Impl {
   GstElement* sink = nullptr;  // borrowed
   Nanos origin{0};
   std::shared_ptr<FramePool> pool;
-  GstCaps* lastCaps = nullptr;  // identity only
   GstVideoInfo info{};
   bool jpeg = false;
   std::uint64_t sequence = 0;
@@ -234,7 +233,6 @@ Result<std::unique_ptr<TraceVideoReader>> TraceVideoReader::open(const std::file
     if (!gst_video_info_from_caps(&i.info, caps.get()))
       return fail(Errc::kParse, "unreadable video caps", path.string());
     reader->format_ = fromGstFormat(GST_VIDEO_INFO_FORMAT(&i.info));
-    i.lastCaps = nullptr;
   }
   if (reader->format_ == PixelFormat::kUnknown || reader->width_ == 0 || reader->height_ == 0) {
     return fail(Errc::kUnsupported, "the trace video's format is not one Basalt replays", path.string());
