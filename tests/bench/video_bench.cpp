@@ -64,11 +64,18 @@ double cpuSecondsSelf() {
 double runForCpu(const std::vector<std::string>& args, const std::map<std::string, std::string>& extraEnv = {}) {
   std::vector<std::string> envStrings;
   for (char** e = environ; *e; ++e) envStrings.emplace_back(*e);
-  for (const auto& [k, v] : extraEnv) envStrings.push_back(k + "=" + v);
+  for (const auto& [k, v] : extraEnv) {
+    std::string entry = k;
+    entry += '=';
+    entry += v;
+    envStrings.push_back(std::move(entry));
+  }
   std::vector<char*> envp;
+  envp.reserve(envStrings.size() + 1);
   for (auto& s : envStrings) envp.push_back(s.data());
   envp.push_back(nullptr);
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   posix_spawn_file_actions_t actions;
@@ -89,7 +96,7 @@ double runForCpu(const std::vector<std::string>& args, const std::map<std::strin
 
 /// The 1080p (or 720p) H.264 clip, I420, made once per run with GStreamer's own tools.
 std::filesystem::path clip(int width, int height) {
-  const auto path = benchDir() / ("clip-" + std::to_string(height) + "p-" + std::to_string(clipFrames()) + ".mp4");
+  auto path = benchDir() / ("clip-" + std::to_string(height) + "p-" + std::to_string(clipFrames()) + ".mp4");
   if (std::filesystem::exists(path)) return path;
   const auto partial = path.string() + ".partial.mp4";
   const double cpu = runForCpu({"gst-launch-1.0",
@@ -140,8 +147,9 @@ void gstPath(benchmark::State& state, const std::string& sink, bool withX) {
   pid_t xvfb = -1;
   std::map<std::string, std::string> env;
   if (withX) {
-    std::vector<char*> argv;
     std::vector<std::string> args = {"Xvfb", ":97", "-screen", "0", "1920x1080x24", "-nolisten", "tcp"};
+    std::vector<char*> argv;
+    argv.reserve(args.size() + 1);
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
     posix_spawn_file_actions_t actions;
@@ -227,7 +235,10 @@ void basaltPath(benchmark::State& state, basalt::PixelFormat cpuConvertTo) {
     Nanos t{0};
     const Nanos step = fromSeconds(1.0 / 30);
     (*player)->waitForFrameDue(t, std::chrono::seconds(10));
-    (void)(*stream)->update((*player)->frameAt(t));
+    if (!(*stream)->update((*player)->frameAt(t))) {
+      state.SkipWithError("the first frame could not be shown");
+      break;
+    }
     const double start = cpuSecondsSelf();
     int shown = 0;
     while (shown < clipFrames() - 1) {
@@ -235,10 +246,9 @@ void basaltPath(benchmark::State& state, basalt::PixelFormat cpuConvertTo) {
       (*player)->waitForFrameDue(t, std::chrono::seconds(10));
       const FrameRef f = (*player)->frameAt(t);
       if (!f) break;
-      (void)(*stream)->update(f);
-      (void)(*output)->beginFrame();
+      if (!(*stream)->update(f) || !(*output)->beginFrame()) break;
       (*overlay)->draw((*stream)->view(), {0, 0, 1920, 1080}, (*output)->size());
-      (void)(*output)->present();
+      if (!(*output)->present()) break;
       glFinish();
       ++shown;
     }
@@ -291,11 +301,11 @@ std::int64_t droppedWithStreams(const std::filesystem::path& file, int count, do
   for (int n = 0; n < frames; ++n) {
     const Nanos due = frameTime(n, 30);
     while (clock.now() - start < due) std::this_thread::sleep_for(std::chrono::microseconds(500));
-    (void)(*output)->beginFrame();
+    if (!(*output)->beginFrame()) return -1;
     for (int i = 0; i < count; ++i) {
       const auto idx = static_cast<std::size_t>(i);
       const FrameRef f = players[idx]->frameAt(due);
-      (void)streams[idx]->update(f);
+      if (!streams[idx]->update(f)) return -1;
       const float w = 1280.0f / static_cast<float>(count);
       (*overlay)->draw(streams[idx]->view(), {w * static_cast<float>(i), 0, w, 720}, (*output)->size());
       const std::int64_t now = players[idx]->currentFrame();
@@ -305,7 +315,7 @@ std::int64_t droppedWithStreams(const std::filesystem::path& file, int count, do
       }
       last[idx] = now;
     }
-    (void)(*output)->present();
+    if (!(*output)->present()) return -1;
     glFinish();
   }
   return dropped;

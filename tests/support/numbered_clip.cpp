@@ -74,10 +74,12 @@ int readFrameNumber(const Frame& frame) {
     case PixelFormat::kNv12:
     case PixelFormat::kNv21:
     case PixelFormat::kGray8: return decodeBars(frame.width, [&](std::uint32_t x) { return row[x]; });
-    case PixelFormat::kYuyv: return decodeBars(frame.width, [&](std::uint32_t x) { return row[2 * x]; });
-    case PixelFormat::kUyvy: return decodeBars(frame.width, [&](std::uint32_t x) { return row[2 * x + 1]; });
+    case PixelFormat::kYuyv: return decodeBars(frame.width, [&](std::uint32_t x) { return row[std::size_t{2} * x]; });
+    case PixelFormat::kUyvy:
+      return decodeBars(frame.width, [&](std::uint32_t x) { return row[std::size_t{2} * x + 1]; });
     case PixelFormat::kRgba8:
-    case PixelFormat::kBgra8: return decodeBars(frame.width, [&](std::uint32_t x) { return row[4 * x + 1]; });
+    case PixelFormat::kBgra8:
+      return decodeBars(frame.width, [&](std::uint32_t x) { return row[std::size_t{4} * x + 1]; });
     default: return -1;
   }
 }
