@@ -85,9 +85,15 @@ TEST(Soak, TwentyFourHoursOfLoopingStayFlat) {
       hours, static_cast<long long>(steps), static_cast<unsigned long long>(loops), rssAfterWarmUp, rssMax,
       fdsAfterWarmUp, fdsMax);
   EXPECT_GE(loops, static_cast<std::uint64_t>(steps / kFrames - 1));
-  // Flat: no more than 2 MiB of growth (allocator noise) and no new descriptors.
-  EXPECT_LE(rssMax, rssAfterWarmUp + 2048) << "resident memory grows with loops";
   EXPECT_LE(fdsMax, fdsAfterWarmUp) << "descriptors grow with loops";
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer keeps freed memory in quarantine (256 MiB by default): resident memory
+  // grows until that fills, whatever the code does. LeakSanitizer checks for leaks instead.
+  std::printf("soak: resident memory not compared under AddressSanitizer (its quarantine grows it)\n");
+#else
+  // Flat: no more than 2 MiB of growth (allocator noise).
+  EXPECT_LE(rssMax, rssAfterWarmUp + 2048) << "resident memory grows with loops";
+#endif
 }
 
 }  // namespace
