@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -101,6 +102,17 @@ Options:
                      possible (the default headless when --frames or --seconds is given)
   --save-image PATH  where a script's save_image writes (default: OUTPUT_DIR/ras.im32)
   --save-model PATH  at the end, write the show as a LAVA script (LAVA's Save Model)
+  --movie PART=FILE  play FILE as the texture of PART (LAVA's texture.switch = video),
+                     looping with no gap; repeat the option for more streams, or for the
+                     same PART to make a playlist
+  --movie-once       play movies once instead of looping
+  --zoom PART[=SCALE][@X,Y]
+                     show PART's movie as a picture over the scene (LAVA's Zoom): SCALE of
+                     its size (default 0.5), top-left corner at X,Y pixels (default 10,10)
+  --audio            play the movies' sound on the default output
+  --record PATH      record the rendered output to PATH (.mp4, .mkv, .mov, .avi, .webm)
+  --record-codec C   h264, mjpeg, vp8, vp9 or auto (H.264; MJPEG for .avi; VP9 for .webm)
+  --record-frames N  stop recording after N frames (LAVA's Rec slider); default: the run
   -h, --help         this text
 
 Exit status: 0 when the show ran, 1 when it could not start or failed, 2 for usage errors.
@@ -121,6 +133,13 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--fast"},
                               {"--save-image", true},
                               {"--save-model", true}});
+                              {"--movie", true},
+                              {"--movie-once"},
+                              {"--zoom", true},
+                              {"--audio"},
+                              {"--record", true},
+                              {"--record-codec", true},
+                              {"--record-frames", true}});
   if (!parsed) return std::unexpected(parsed.error());
   RunOptions run;
   for (const ParsedOption& o : *parsed) {
@@ -167,6 +186,37 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
     } else if (o.name == "--save-model") {
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "--save-model needs a file name");
       run.saveModel = std::filesystem::path(o.value);
+    } else if (o.name == "--movie") {
+      auto m = parseMovieOption(o.value);
+      if (!m) return std::unexpected(m.error());
+      run.movies.push_back(std::move(*m));
+    } else if (o.name == "--movie-once") {
+      run.movieOnce = true;
+    } else if (o.name == "--zoom") {
+      auto z = parseZoomOption(o.value);
+      if (!z) return std::unexpected(z.error());
+      run.zooms.push_back(std::move(*z));
+    } else if (o.name == "--audio") {
+      run.audio = true;
+    } else if (o.name == "--record") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--record needs a file name");
+      run.record = std::filesystem::path(o.value);
+    } else if (o.name == "--record-codec") {
+      auto c = media::parseVideoCodec(o.value);
+      if (!c) return std::unexpected(c.error());
+      run.recordCodec = std::string(o.value);
+    } else if (o.name == "--record-frames") {
+      auto n = integerOption(o.name, o.value, 1, INT64_MAX);
+      if (!n) return std::unexpected(n.error());
+      run.recordFrames = *n;
+    }
+  }
+  for (const auto& [name, zoom] : run.zooms) {
+    const bool known =
+        std::any_of(run.movies.begin(), run.movies.end(), [&](const auto& m) { return m.first == name; });
+    if (!known) {
+      return fail(Errc::kInvalidArgument,
+                  fmt::format("--zoom {}: no movie of that name; give --movie {}=FILE too", name, name));
     }
   }
   return run;
@@ -246,6 +296,47 @@ int runShow(const RunOptions& options) {
     frameLoop.addParticipant(*player);
   }
 
+  // Movies: GStreamer starts only when a show has some (start-up stays fast without).
+  std::unique_ptr<VideoStreams> videos;
+  if (!options.movies.empty()) {
+    std::vector<MovieStreamSpec> specs;
+    for (const auto& [name, file] : options.movies) {
+      auto same = std::find_if(specs.begin(), specs.end(), [&](const MovieStreamSpec& s) { return s.name == name; });
+      if (same == specs.end()) {
+        specs.push_back({name, {file}, !options.movieOnce, options.audio, std::nullopt});
+      } else {
+        same->files.push_back(file);  // the same part again: a playlist
+      }
+    }
+    for (const auto& [name, zoom] : options.zooms) {
+      for (MovieStreamSpec& s : specs) {
+        if (s.name == name) s.zoom = zoom;
+      }
+    }
+    auto v = VideoStreams::create(specs, show, **renderer, manual);
+    if (!v) return failWith(v.error(), "cannot start the movies");
+    videos = std::move(*v);
+    frameLoop.addParticipant(*videos);
+  }
+  // Recording comes after the movies so that it sees the Zoom pictures.
+  std::unique_ptr<ScreenRecorder> recorder;
+  if (options.record) {
+    media::RecorderOptions ro;
+    ro.path = *options.record;
+    ro.width = options.width;
+    ro.height = options.height;
+    ro.fps = options.fps;
+    ro.codec = *media::parseVideoCodec(options.recordCodec);
+    ro.maxFrames = options.recordFrames.value_or(-1);
+    ro.waitForEncoder = manual;  // offline runs keep every frame; live shows drop rather than wait
+    auto r = ScreenRecorder::create(ro);
+    if (!r) return failWith(r.error(), "cannot record");
+    recorder = std::move(*r);
+    frameLoop.addParticipant(*recorder);
+  }
+
+  auto stopOnSignal = (*loop)->watchSignals({SIGINT, SIGTERM}, [&frameLoop](int) { frameLoop.requestStop(); });
+  if (!stopOnSignal) return failWith(stopOnSignal.error(), "cannot watch for signals");
 
   Image snapshot;
   bool snapshotWritten = false;
@@ -276,8 +367,21 @@ int runShow(const RunOptions& options) {
   if (player) printScriptSummary(*player);
   if (snapshotWritten) fmt::print("basalt: snapshot written to {}\n", snapshotPath.string());
   if (options.saveModel) fmt::print("basalt: model saved to {}\n", options.saveModel->string());
+  if (videos) {
+    for (const std::string& line : videos->status()) fmt::print("basalt: {}\n", line);
+  }
+  int status = 0;
+  if (recorder) {
+    if (auto r = recorder->finish(); !r) {
+      std::fflush(stdout);
+      status = failWith(r.error(), "the recording failed (the show itself ran)");
+    } else {
+      fmt::print("basalt: recorded {} frames to {} ({})\n", recorder->frames(), recorder->options().path.string(),
+                 recorder->describe());
+    }
+  }
   std::fflush(stdout);
-  return 0;
+  return status;
 }
 
 }  // namespace basalt::kiosk

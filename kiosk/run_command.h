@@ -9,6 +9,7 @@
 #include <span>
 #include <string_view>
 
+#include "kiosk/video_streams.h"
 #include "runtime/error.h"
 
 namespace basalt::kiosk {
@@ -32,6 +33,13 @@ struct RunOptions {
   ClockMode clock = ClockMode::kAuto;
   std::optional<std::filesystem::path> saveImage;  ///< a script's bare save_image writes this
   std::optional<std::filesystem::path> saveModel;  ///< write the show as .mdl at the end
+  std::vector<std::pair<std::string, std::filesystem::path>> movies;  ///< --movie PART=FILE, in order
+  std::vector<std::pair<std::string, ZoomSpec>> zooms;                ///< --zoom PART[=SCALE][@X,Y]
+  bool movieOnce = false;                                             ///< --movie-once: no repeat
+  bool audio = false;                                                 ///< --audio: movie sound on
+  std::optional<std::filesystem::path> record;                        ///< --record PATH
+  std::string recordCodec = "auto";                                   ///< --record-codec
+  std::optional<std::int64_t> recordFrames;                           ///< --record-frames N
 };
 
 /// \brief Parses the arguments after `run`.
