@@ -132,7 +132,7 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--realtime"},
                               {"--fast"},
                               {"--save-image", true},
-                              {"--save-model", true}});
+                              {"--save-model", true},
                               {"--movie", true},
                               {"--movie-once"},
                               {"--zoom", true},
@@ -334,9 +334,6 @@ int runShow(const RunOptions& options) {
     recorder = std::move(*r);
     frameLoop.addParticipant(*recorder);
   }
-
-  auto stopOnSignal = (*loop)->watchSignals({SIGINT, SIGTERM}, [&frameLoop](int) { frameLoop.requestStop(); });
-  if (!stopOnSignal) return failWith(stopOnSignal.error(), "cannot watch for signals");
 
   Image snapshot;
   bool snapshotWritten = false;
