@@ -126,7 +126,10 @@ DeviceManager::DeviceManager(const Clock& clock, BoundedQueue<Event>& events, Co
 
 DeviceManager::~DeviceManager() { stop(); }
 
-void DeviceManager::addProvider(std::unique_ptr<DeviceProvider> provider) { providers_.push_back(std::move(provider)); }
+void DeviceManager::addProvider(std::unique_ptr<DeviceProvider> provider) {
+  provider->watchHotplug([this](HotplugEvent e) { notifyHotplug(std::move(e)); });
+  providers_.push_back(std::move(provider));
+}
 
 Result<DeviceId> DeviceManager::request(DeviceRequest request) {
   for (const auto& s : slots_) {

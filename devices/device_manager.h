@@ -11,6 +11,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -70,6 +71,14 @@ struct DeviceCandidate {
   std::string usage;
 };
 
+/// \brief A hotplug notification (from libudev, or from tests and simulated backends).
+struct HotplugEvent {
+  enum class Action : std::uint8_t { kAdded, kRemoved, kChanged };
+  Action action = Action::kAdded;
+  std::string subsystem;  ///< "hidraw", "video4linux", "usb", "tty", "sim", ...
+  std::string devnode;    ///< "/dev/hidraw3", or the path a simulated device uses
+};
+
 /// \brief One backend: lists the devices it can see and opens them. Implementations live in
 /// devices/hid, devices/v4l2, devices/libcamera, devices/serial and sim/.
 ///
@@ -85,14 +94,9 @@ class DeviceProvider {
   [[nodiscard]] virtual Result<std::shared_ptr<VideoSource>> openVideoSource(const DeviceCandidate& candidate,
                                                                              const DeviceRequest& request,
                                                                              const Clock& clock);
-};
-
-/// \brief A hotplug notification (from libudev, or from tests and simulated backends).
-struct HotplugEvent {
-  enum class Action : std::uint8_t { kAdded, kRemoved, kChanged };
-  Action action = Action::kAdded;
-  std::string subsystem;  ///< "hidraw", "video4linux", "usb", "tty", "sim", ...
-  std::string devnode;    ///< "/dev/hidraw3", or the path a simulated device uses
+  /// \brief Backends with hotplug signals of their own (libcamera) report through `notify`
+  /// (thread-safe; called by DeviceManager::addProvider).
+  virtual void watchHotplug(std::function<void(HotplugEvent)> notify) { (void)notify; }
 };
 
 /// \brief What the status server and `basalt devices` show for one requested device.
