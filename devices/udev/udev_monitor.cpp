@@ -28,7 +28,7 @@ struct DeviceUnref {
 }  // namespace
 
 struct UdevMonitor::Impl {
-  std::unique_ptr<udev, UdevUnref> udev;
+  std::unique_ptr<struct udev, UdevUnref> context;
   std::unique_ptr<udev_monitor, MonitorUnref> monitor;
   UniqueFd stopFd;
   std::thread thread;
@@ -41,9 +41,9 @@ UdevMonitor::~UdevMonitor() { stop(); }
 Result<std::unique_ptr<UdevMonitor>> UdevMonitor::create(std::vector<std::string> subsystems) {
   if (subsystems.empty()) subsystems = {"hidraw", "video4linux", "usb", "tty"};
   auto impl = std::make_unique<Impl>();
-  impl->udev.reset(udev_new());
-  if (!impl->udev) return fail(Errc::kUnavailable, "libudev could not start", "udev");
-  impl->monitor.reset(udev_monitor_new_from_netlink(impl->udev.get(), "udev"));
+  impl->context.reset(udev_new());
+  if (!impl->context) return fail(Errc::kUnavailable, "libudev could not start", "udev");
+  impl->monitor.reset(udev_monitor_new_from_netlink(impl->context.get(), "udev"));
   if (!impl->monitor) {
     return fail(Errc::kUnavailable, "no udev netlink socket (is udevd running?); devices are found by retrying",
                 "udev");
