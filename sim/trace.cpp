@@ -435,6 +435,7 @@ void TraceRecorder::writerLoop() {
   for (;;) {
     framesReady_.wait(lock, [this] { return stopping_ || !frames_.empty(); });
     if (frames_.empty()) {
+      framesDone_.notify_all();
       if (stopping_) return;
       continue;
     }
@@ -445,16 +446,24 @@ void TraceRecorder::writerLoop() {
     TraceVideoWriter* writer = it->second.writer.get();
     const Nanos pts = p.frame->pts - start_;
     lastTime_ = std::max(lastTime_, pts);
+    writing_ = true;
     lock.unlock();  // write without holding the lock: device threads keep queueing
     auto r = writer->write(*p.frame, pts);
     p.frame.reset();
     lock.lock();
+    writing_ = false;
+    if (frames_.empty()) framesDone_.notify_all();
     if (r) {
       ++framesWritten_;
     } else {
       noteError(r.error());
     }
   }
+}
+
+bool TraceRecorder::drain(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  return framesDone_.wait_for(lock, timeout, [this] { return frames_.empty() && !writing_; });
 }
 
 Result<TraceInfo> TraceRecorder::finish() {

@@ -84,6 +84,11 @@ class TraceRecorder final : public devices::ReportTap, public devices::FrameTap 
   void onReport(DeviceId device, Nanos time, std::span<const std::uint8_t> report) override;
   void onFrame(DeviceId device, const FrameRef& frame) override;
 
+  /// \brief Waits until every frame queued so far is written (at most `timeout`). A recording
+  /// under a ManualClock runs faster than real time; calling this once per frame keeps the
+  /// camera's frame pool from running dry while the writer catches up.
+  bool drain(std::chrono::milliseconds timeout = std::chrono::seconds(5));
+
   /// \brief Stops, flushes every file and writes trace.toml. The first write error, if any.
   [[nodiscard]] Result<TraceInfo> finish();
 
@@ -119,6 +124,8 @@ class TraceRecorder final : public devices::ReportTap, public devices::FrameTap 
   std::map<DeviceId, VideoFile> videos_;
   std::deque<PendingFrame> frames_;
   std::condition_variable framesReady_;
+  std::condition_variable framesDone_;
+  bool writing_ = false;  // the writer thread holds a frame outside the lock
   bool stopping_ = false;
   std::optional<Error> firstError_;
   std::uint64_t reports_ = 0;

@@ -730,6 +730,26 @@ std::shared_ptr<VideoSource> makeV4l2Camera(const std::string& path, V4l2Options
   return std::make_shared<V4l2Camera>(std::move(info), path, options, clock);
 }
 
+Result<void> setV4l2ControlByName(const std::string& path, const std::string& name, int value) {
+  UniqueFd fd(::open(path.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC));
+  if (!fd) return std::unexpected(sysError(path, "cannot open", errno));
+  v4l2_queryctrl q{};
+  q.id = V4L2_CTRL_FLAG_NEXT_CTRL;
+  while (xioctl(fd.get(), VIDIOC_QUERYCTRL, &q) == 0) {
+    if (name == reinterpret_cast<const char*>(q.name)) {
+      v4l2_control c{};
+      c.id = q.id;
+      c.value = value;
+      if (xioctl(fd.get(), VIDIOC_S_CTRL, &c) != 0) {
+        return std::unexpected(sysError(path, fmt::format("cannot set '{}' to {}", name, value), errno));
+      }
+      return {};
+    }
+    q.id |= V4L2_CTRL_FLAG_NEXT_CTRL;
+  }
+  return fail(Errc::kNotFound, fmt::format("the device has no control named '{}'", name), path);
+}
+
 std::vector<DeviceCandidate> V4l2Provider::enumerate() {
   std::vector<DeviceCandidate> out;
   std::vector<std::string> nodes;

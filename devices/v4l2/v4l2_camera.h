@@ -62,6 +62,10 @@ struct V4l2Options {
 [[nodiscard]] std::shared_ptr<VideoSource> makeV4l2Camera(const std::string& path, V4l2Options options,
                                                           const Clock& clock, DeviceInfo info = {});
 
+/// \brief Sets the control named `name` (as VIDIOC_QUERYCTRL reports it, e.g. vivid's "DV Timings
+/// Signal Mode") to `value` (a menu index for menu controls). For tests and operators' tools.
+[[nodiscard]] Result<void> setV4l2ControlByName(const std::string& path, const std::string& name, int value);
+
 /// \brief The `v4l2` backend: every /dev/video* node that captures video.
 class V4l2Provider final : public DeviceProvider {
  public:
