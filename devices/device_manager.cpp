@@ -182,7 +182,7 @@ void DeviceManager::transition(Slot& slot, DeviceState state, Nanos now) {
   slot.since = now;
   if (state == DeviceState::kLive || state == DeviceState::kLost) {
     // Tell the bindings (a lost dial box goes quiet; shuttles stop) in the event stream itself.
-    events_.push(Event{now, slot.id, EventKind::kDeviceState, 0, static_cast<double>(state)});
+    events_.push(Event{now, slot.id, EventKind::kDeviceState, 0, state == DeviceState::kLive ? 1.0 : 0.0});
   }
 }
 

@@ -65,7 +65,7 @@ struct Rig {
     std::vector<DeviceState> states;
     Event e;
     while (events.pop(e)) {
-      if (e.kind == EventKind::kDeviceState) states.push_back(static_cast<DeviceState>(e.value));
+      if (e.kind == EventKind::kDeviceState) states.push_back(e.value == 1 ? DeviceState::kLive : DeviceState::kLost);
       if (e.kind == EventKind::kDialDelta && dialEvents) ++*dialEvents;
     }
     return states;
