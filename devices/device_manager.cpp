@@ -355,6 +355,8 @@ void DeviceManager::publish() {
     st.lastError = s.lastError;
     st.attempts = s.attempts;
     st.nextAttempt = s.nextAttempt;
+    if (s.dial && s.state == DeviceState::kLive) st.reportDescriptor = s.dial->reportDescriptor();
+    if (s.video && s.state == DeviceState::kLive) st.mode = s.video->mode();
     if (s.video && s.state == DeviceState::kLive && s.video->state() != DeviceState::kLive) {
       // The device itself is lost but recovering (an HDMI signal gone): show its state.
       st.state = s.video->state();

@@ -111,6 +111,8 @@ struct DeviceStatus {
   std::string lastError;    ///< why it is not live, if it is not
   std::uint32_t attempts = 0;  ///< failed opens since it was last live
   Nanos nextAttempt{0};     ///< when it is tried again (absent or lost)
+  std::vector<std::uint8_t> reportDescriptor;  ///< a live dial box's (for recording)
+  std::optional<VideoMode> mode;               ///< a live video source's
 };
 
 /// \brief A video source as the renderer sees it: stable for the life of the manager while the

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "kiosk/devices_command.h"
+#include "kiosk/record_command.h"
 #include "kiosk/run_command.h"
 
 namespace basalt::kiosk {
@@ -13,6 +15,8 @@ namespace {
 // One line per command; each command lives in its own file.
 constexpr CommandSpec kCommands[] = {
     {"run", "play a show (the default show when none is given)", runUsage, runMain},
+    {"devices", "list dial boxes, cameras and capture cards, and why one cannot be used", devicesUsage, devicesMain},
+    {"record", "record live devices into a trace folder for replay", recordUsage, recordMain},
 };
 
 constexpr std::string_view kVersion = "basalt 0.1.0";

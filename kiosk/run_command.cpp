@@ -13,6 +13,7 @@
 #include <fmt/std.h>
 
 #include "kiosk/commands.h"
+#include "kiosk/device_wiring.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/options.h"
 #include "media/image_io.h"
@@ -91,6 +92,9 @@ Options:
   --realtime         pace frames on the system clock at the frame rate
   --fast             step a manual clock exactly 1/fps per frame and render as fast as
                      possible (the default headless when --frames or --seconds is given)
+  --replay PATH      play the devices recorded in a trace folder (basalt record) or an
+                     hid-recorder file as if they were plugged in; dials drive LAVA's dial table
+  --replay-once      play the recording once instead of looping
   -h, --help         this text
 
 Exit status: 0 when the show ran, 1 when it could not start or failed, 2 for usage errors.
@@ -108,7 +112,9 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--output-dir", true},
                               {"--fps", true},
                               {"--realtime"},
-                              {"--fast"}});
+                              {"--fast"},
+                              {"--replay", true},
+                              {"--replay-once"}});
   if (!parsed) return std::unexpected(parsed.error());
   RunOptions run;
   for (const ParsedOption& o : *parsed) {
@@ -144,6 +150,11 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       run.clock = ClockMode::kSystem;
     } else if (o.name == "--fast") {
       run.clock = ClockMode::kManual;
+    } else if (o.name == "--replay") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--replay needs a trace folder or .hid file");
+      run.replay = std::filesystem::path(o.value);
+    } else if (o.name == "--replay-once") {
+      run.replayOnce = true;
     }
   }
   return run;
@@ -187,6 +198,20 @@ int runShow(const RunOptions& options) {
   FrameLoop frameLoop({options.fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output,
                       **renderer);
 
+  // Devices: a replayed trace drives the show through LAVA's dial table.
+  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  std::unique_ptr<DeviceWiring> devices;
+  if (options.replay) {
+    runtime::EventLoop* eventLoop = loop->get();
+    devices = std::make_unique<DeviceWiring>(clock, [eventLoop] { eventLoop->wake(); });
+    if (auto r = devices->addReplay(*options.replay, !options.replayOnce); !r) {
+      return failWith(r.error(), "cannot replay");
+    }
+    frameLoop.addParticipant(devices->participant());
+    frameLoop.setEvents(&devices->events(), &bindings);
+    devices->start(manual);
+  }
+
   auto stopOnSignal = (*loop)->watchSignals({SIGINT, SIGTERM}, [&frameLoop](int) { frameLoop.requestStop(); });
   if (!stopOnSignal) return failWith(stopOnSignal.error(), "cannot watch for signals");
 
@@ -201,6 +226,11 @@ int runShow(const RunOptions& options) {
   });
 
   auto stats = frameLoop.run();
+  std::vector<devices::DeviceStatus> deviceStatus;
+  if (devices) {
+    deviceStatus = devices->manager().status();
+    devices->stop();
+  }
   if (!stats) return failWith(stats.error(), "the show stopped");
 
   const double fps = stats->wallSeconds > 0 ? static_cast<double>(stats->frames) / stats->wallSeconds : 0;
@@ -209,6 +239,12 @@ int runShow(const RunOptions& options) {
   fmt::print("basalt: output: {}\n", (*output)->describe());
   fmt::print("basalt: first frame after {:.1f} ms\n", stats->firstFrameSeconds * 1000);
   if (snapshotWritten) fmt::print("basalt: snapshot written to {}\n", snapshotPath.string());
+  if (devices) {
+    for (const devices::DeviceStatus& s : deviceStatus) {
+      fmt::print("basalt: replayed {} '{}' ({})\n", devices::deviceKindName(s.kind), s.name,
+                 s.lastError.empty() ? std::string(devices::deviceStateName(s.state)) : s.lastError);
+    }
+  }
   std::fflush(stdout);
   return 0;
 }

@@ -299,7 +299,8 @@ LibcameraProvider::LibcameraProvider() {
   if (state_) return;
   state_ = std::make_shared<State>();
   // libcamera logs every INFO line to stderr; keep its warnings unless the user asked otherwise.
-  if (!std::getenv("LIBCAMERA_LOG_LEVELS")) lc::logSetLevel("*", "WARN");
+  // libcamera reads LIBCAMERA_LOG_LEVELS once, when its logger starts (on first use, here).
+  ::setenv("LIBCAMERA_LOG_LEVELS", "*:ERROR", 0);
   state_->manager = std::make_unique<lc::CameraManager>();
   if (const int rc = state_->manager->start(); rc != 0) {
     state_->error = fmt::format("libcamera could not start: {}", std::strerror(-rc));
