@@ -167,7 +167,7 @@ class DeviceManager {
   void notifyHotplug(HotplugEvent event);
 
   /// \brief Runs step() on a thread of its own every `period` and at once on hotplug.
-  void start(Nanos period = std::chrono::milliseconds(10));
+  void start(Nanos period = std::chrono::milliseconds(4));
   /// \brief Stops the thread and closes every device.
   void stop();
 

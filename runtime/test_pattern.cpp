@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 
 namespace basalt {
 
@@ -70,7 +71,37 @@ Box movingBox(std::uint32_t w, std::uint32_t h, std::uint64_t frameNumber) {
 }  // namespace
 
 bool drawTestPattern(Frame& frame, TestPattern pattern, std::uint64_t frameNumber, bool moving, Rgb8 solid) {
+  return drawTestPatternRegion(frame, pattern, frameNumber, moving, solid, 0, 0, frame.width, frame.height);
+}
+
+bool drawMovingBoxOver(Frame& frame, const Frame& background, TestPattern pattern, std::uint64_t frameNumber,
+                       Rgb8 solid) {
+  if (background.format != frame.format || background.width != frame.width || background.height != frame.height ||
+      background.planeCount != frame.planeCount) {
+    return false;
+  }
+  for (int i = 0; i < frame.planeCount; ++i) {
+    const auto& src = background.planes[static_cast<std::size_t>(i)];
+    auto& dst = frame.planes[static_cast<std::size_t>(i)];
+    if (!src.data || !dst.data) return false;
+    const std::size_t rows = src.stride ? src.size / src.stride : 0;
+    const std::size_t bytes = std::min(src.stride, dst.stride);
+    for (std::size_t y = 0; y < rows; ++y) std::memcpy(dst.data + y * dst.stride, src.data + y * src.stride, bytes);
+  }
+  const Box b = movingBox(frame.width, frame.height, frameNumber);
+  // Redraw the box and a 2-pixel margin (shared chroma samples) exactly as a full draw would.
+  const std::uint32_t x0 = b.x0 >= 2 ? (b.x0 - 2) & ~1u : 0, y0 = b.y0 >= 2 ? (b.y0 - 2) & ~1u : 0;
+  const std::uint32_t x1 = std::min(frame.width, b.x1 + 2), y1 = std::min(frame.height, b.y1 + 2);
+  return drawTestPatternRegion(frame, pattern, frameNumber, true, solid, x0, y0, x1, y1);
+}
+
+bool drawTestPatternRegion(Frame& frame, TestPattern pattern, std::uint64_t frameNumber, bool moving, Rgb8 solid,
+                           std::uint32_t rx0, std::uint32_t ry0, std::uint32_t rx1, std::uint32_t ry1) {
   const std::uint32_t w = frame.width, h = frame.height;
+  rx0 &= ~1u;
+  ry0 &= ~1u;
+  rx1 = std::min(rx1, w);
+  ry1 = std::min(ry1, h);
   for (int i = 0; i < frame.planeCount; ++i) {
     if (!frame.planes[static_cast<std::size_t>(i)].data) return false;
   }
@@ -88,9 +119,9 @@ bool drawTestPattern(Frame& frame, TestPattern pattern, std::uint64_t frameNumbe
     case PixelFormat::kRgb8: {
       const std::uint32_t bpp = frame.format == PixelFormat::kRgb8 ? 3 : 4;
       const bool bgr = frame.format == PixelFormat::kBgra8;
-      for (std::uint32_t y = 0; y < h; ++y) {
+      for (std::uint32_t y = ry0; y < ry1; ++y) {
         std::uint8_t* row = p0.data + std::size_t{y} * p0.stride;
-        for (std::uint32_t x = 0; x < w; ++x) {
+        for (std::uint32_t x = rx0; x < rx1; ++x) {
           const Rgb8 c = colourAt(x, y);
           std::uint8_t* px = row + std::size_t{x} * bpp;
           px[0] = bgr ? c.b : c.r;
@@ -102,17 +133,17 @@ bool drawTestPattern(Frame& frame, TestPattern pattern, std::uint64_t frameNumbe
       return true;
     }
     case PixelFormat::kGray8:
-      for (std::uint32_t y = 0; y < h; ++y) {
+      for (std::uint32_t y = ry0; y < ry1; ++y) {
         std::uint8_t* row = p0.data + std::size_t{y} * p0.stride;
-        for (std::uint32_t x = 0; x < w; ++x) row[x] = toYuv(colourAt(x, y)).y;
+        for (std::uint32_t x = rx0; x < rx1; ++x) row[x] = toYuv(colourAt(x, y)).y;
       }
       return true;
     case PixelFormat::kYuyv:
     case PixelFormat::kUyvy: {
       const bool yuyv = frame.format == PixelFormat::kYuyv;
-      for (std::uint32_t y = 0; y < h; ++y) {
+      for (std::uint32_t y = ry0; y < ry1; ++y) {
         std::uint8_t* row = p0.data + std::size_t{y} * p0.stride;
-        for (std::uint32_t x = 0; x < w; x += 2) {
+        for (std::uint32_t x = rx0; x < rx1; x += 2) {
           const Yuv a = toYuv(colourAt(x, y));
           const Yuv b = x + 1 < w ? toYuv(colourAt(x + 1, y)) : a;
           std::uint8_t* px = row + std::size_t{x} * 2;
@@ -131,14 +162,14 @@ bool drawTestPattern(Frame& frame, TestPattern pattern, std::uint64_t frameNumbe
     case PixelFormat::kNv21:
     case PixelFormat::kI420:
     case PixelFormat::kYv12: {
-      for (std::uint32_t y = 0; y < h; ++y) {
+      for (std::uint32_t y = ry0; y < ry1; ++y) {
         std::uint8_t* row = p0.data + std::size_t{y} * p0.stride;
-        for (std::uint32_t x = 0; x < w; ++x) row[x] = toYuv(colourAt(x, y)).y;
+        for (std::uint32_t x = rx0; x < rx1; ++x) row[x] = toYuv(colourAt(x, y)).y;
       }
       const bool semi = frame.format == PixelFormat::kNv12 || frame.format == PixelFormat::kNv21;
       const bool vFirst = frame.format == PixelFormat::kNv21 || frame.format == PixelFormat::kYv12;
-      for (std::uint32_t cy = 0; cy < (h + 1) / 2; ++cy) {
-        for (std::uint32_t cx = 0; cx < (w + 1) / 2; ++cx) {
+      for (std::uint32_t cy = ry0 / 2; cy < (ry1 + 1) / 2; ++cy) {
+        for (std::uint32_t cx = rx0 / 2; cx < (rx1 + 1) / 2; ++cx) {
           const Yuv c = toYuv(colourAt(std::min(cx * 2, w - 1), std::min(cy * 2, h - 1)));
           if (semi) {
             auto& p1 = frame.planes[1];

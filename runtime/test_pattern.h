@@ -30,6 +30,16 @@ struct Rgb8 {
 /// frames can be seen and tested. Returns false for formats it cannot draw (MJPEG, dmabuf-only).
 bool drawTestPattern(Frame& frame, TestPattern pattern, std::uint64_t frameNumber, bool movingBox, Rgb8 solid = {});
 
+/// \brief The same picture as drawTestPattern(..., moving = true), drawn the fast way: copies
+/// `background` (drawn once with moving = false, same format and size) and redraws only the box.
+bool drawMovingBoxOver(Frame& frame, const Frame& background, TestPattern pattern, std::uint64_t frameNumber,
+                       Rgb8 solid = {});
+
+/// \brief drawTestPattern restricted to the pixels [x0, x1) x [y0, y1) (x0 and y0 rounded down to
+/// even, so that shared chroma samples are written whole).
+bool drawTestPatternRegion(Frame& frame, TestPattern pattern, std::uint64_t frameNumber, bool movingBox, Rgb8 solid,
+                           std::uint32_t x0, std::uint32_t y0, std::uint32_t x1, std::uint32_t y1);
+
 /// \brief The colour at pixel (x, y) of an RGB-family frame or the luma of a YUV one, for tests.
 [[nodiscard]] Rgb8 samplePixel(const Frame& frame, std::uint32_t x, std::uint32_t y);
 

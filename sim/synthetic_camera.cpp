@@ -31,7 +31,7 @@ Result<void> SyntheticCamera::doOpen() {
                 info().path);
   }
   current_ = config_.mode;
-  pool_ = FramePool::create({current_.format, current_.width, current_.height, config_.poolSize, 1, true});
+  makePool();
   origin_ = clock().now();
   nextFrame_ = 0;
   nextFault_ = 0;
@@ -42,7 +42,17 @@ Result<void> SyntheticCamera::doOpen() {
   return {};
 }
 
-void SyntheticCamera::doClose() { pool_.reset(); }
+void SyntheticCamera::doClose() {
+  background_.reset();
+  pool_.reset();
+}
+
+void SyntheticCamera::makePool() {
+  background_.reset();
+  pool_ = FramePool::create({current_.format, current_.width, current_.height, config_.poolSize + 1, 1, true});
+  background_ = pool_->acquire();
+  drawTestPattern(*background_, config_.pattern, 0, false);
+}
 
 void SyntheticCamera::doService(Nanos now) {
   if (present_ && !present_->load()) {
@@ -64,7 +74,7 @@ void SyntheticCamera::doService(Nanos now) {
         case CameraFault::Kind::kResolutionChange:
           current_.width = f.width;
           current_.height = f.height;
-          pool_ = FramePool::create({current_.format, current_.width, current_.height, config_.poolSize, 1, true});
+          makePool();
           setMode(current_);
           break;
         case CameraFault::Kind::kStall: quietUntil_ = at + f.duration; break;
@@ -85,7 +95,11 @@ void SyntheticCamera::doService(Nanos now) {
       countDrop();  // the show holds every frame: drop this one, like a real driver
       continue;
     }
-    drawTestPattern(*frame, config_.pattern, nextFrame_ - 1, config_.moving);
+    if (config_.moving) {
+      drawMovingBoxOver(*frame, *background_, config_.pattern, nextFrame_ - 1);
+    } else {
+      drawTestPattern(*frame, config_.pattern, nextFrame_ - 1, false);
+    }
     frame->pts = due;
     frame->captureTime = due;
     frame->sequence = nextFrame_ - 1;

@@ -49,10 +49,12 @@ class SyntheticCamera final : public devices::VideoSource {
   Result<void> doOpen() override;
   void doClose() override;
   void doService(Nanos now) override;
+  void makePool();
 
   SyntheticCameraConfig config_;
   PresenceFlag present_;
   std::shared_ptr<FramePool> pool_;
+  FrameRef background_;  // the pattern without the moving box, drawn once per mode
   devices::VideoMode current_;
   Nanos origin_{0};
   std::uint64_t nextFrame_ = 0;
