@@ -104,13 +104,13 @@ struct DeviceStatus {
   std::string name;
   DeviceKind kind = DeviceKind::kDialBox;
   DeviceState state = DeviceState::kAbsent;
-  Nanos since{0};           ///< Clock time of the last state change
-  DeviceId id = 0;          ///< the id its events carry
-  DeviceInfo device;        ///< the device in use, or the last one used
-  std::string match;        ///< the rule, described
-  std::string lastError;    ///< why it is not live, if it is not
-  std::uint32_t attempts = 0;  ///< failed opens since it was last live
-  Nanos nextAttempt{0};     ///< when it is tried again (absent or lost)
+  Nanos since{0};                              ///< Clock time of the last state change
+  DeviceId id = 0;                             ///< the id its events carry
+  DeviceInfo device;                           ///< the device in use, or the last one used
+  std::string match;                           ///< the rule, described
+  std::string lastError;                       ///< why it is not live, if it is not
+  std::uint32_t attempts = 0;                  ///< failed opens since it was last live
+  Nanos nextAttempt{0};                        ///< when it is tried again (absent or lost)
   std::vector<std::uint8_t> reportDescriptor;  ///< a live dial box's (for recording)
   std::optional<VideoMode> mode;               ///< a live video source's
 };
@@ -130,8 +130,8 @@ class ManagedVideoStream final : public FrameSource {
   void attach(std::shared_ptr<VideoSource> source);
   void detach(SourceState state, Nanos since);
 
-  mutable std::mutex mutex_;                // guards the fields below; held only briefly
-  std::shared_ptr<VideoSource> source_;     // the live device, or null
+  mutable std::mutex mutex_;                            // guards the fields below; held only briefly
+  std::shared_ptr<VideoSource> source_;                 // the live device, or null
   SourceHealth idle_{SourceState::kWaiting, Nanos{0}};  // health while no device is attached
 };
 
@@ -214,9 +214,9 @@ class DeviceManager {
   ReportTap* reportTap_ = nullptr;  // guarded by mutex_
   FrameTap* frameTap_ = nullptr;    // guarded by mutex_
 
-  mutable std::mutex mutex_;               // guards the fields below
-  std::vector<HotplugEvent> hotplug_;      // pending notifications (bounded: oldest dropped past 256)
-  std::vector<DeviceStatus> status_;       // published after every step that changed something
+  mutable std::mutex mutex_;           // guards the fields below
+  std::vector<HotplugEvent> hotplug_;  // pending notifications (bounded: oldest dropped past 256)
+  std::vector<DeviceStatus> status_;   // published after every step that changed something
   std::map<std::string, std::shared_ptr<ManagedVideoStream>, std::less<>> streams_;
   bool tapsChanged_ = false;
   std::condition_variable wake_;

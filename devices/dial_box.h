@@ -99,9 +99,9 @@ class DialBox {
   DeviceId id_ = 0;
   BoundedQueue<Event>* events_ = nullptr;  // set before doOpen(), cleared after doClose()
   std::atomic<ReportTap*> tap_{nullptr};
-  std::atomic<bool> lost_{false};      // set by reportLost() on any thread, read by service()
-  mutable std::mutex lostMutex_;       // guards lostReason_
-  std::optional<Error> lostReason_;    // guarded by lostMutex_
+  std::atomic<bool> lost_{false};                  // set by reportLost() on any thread, read by service()
+  mutable std::mutex lostMutex_;                   // guards lostReason_
+  std::optional<Error> lostReason_;                // guarded by lostMutex_
   std::unique_ptr<VirtualReportEncoder> encoder_;  // used by emit() when !rawReports_
 };
 

@@ -75,10 +75,10 @@ void VideoSource::service(Nanos now) {
   const std::int64_t last = lastDelivery_.load(std::memory_order_relaxed);
   if (state() == DeviceState::kLive && now.count() - last > stallTimeout_.load(std::memory_order_relaxed)) {
     stalled_.store(true, std::memory_order_release);
-    reportLost(Error(Errc::kTimeout,
-                     fmt::format("no frame for {:.1f} s; the camera stalled", toSeconds(now - Nanos{last})),
-                     describeDevice(info_)),
-               true);
+    reportLost(
+        Error(Errc::kTimeout, fmt::format("no frame for {:.1f} s; the camera stalled", toSeconds(now - Nanos{last})),
+              describeDevice(info_)),
+        true);
   }
 }
 
@@ -146,15 +146,15 @@ Result<void> VideoSource::doApplyControls(const VideoControls& controls) {
   // No hardware controls: the renderer mirrors; the frame-rate limit is applied in deliver().
   setMirrorInRenderer(controls.mirror);
   if (controls.input > 0) {
-    return fail(Errc::kInvalidArgument, fmt::format("this source has one input; input {} does not exist", controls.input),
+    return fail(Errc::kInvalidArgument,
+                fmt::format("this source has one input; input {} does not exist", controls.input),
                 describeDevice(info_));
   }
   return {};
 }
 
 std::uint64_t VideoSource::framesDropped() const {
-  return rateDrops_.load(std::memory_order_relaxed) + backendDrops_.load(std::memory_order_relaxed) +
-         queue_.dropped();
+  return rateDrops_.load(std::memory_order_relaxed) + backendDrops_.load(std::memory_order_relaxed) + queue_.dropped();
 }
 
 bool VideoSource::deliver(FrameRef frame) {

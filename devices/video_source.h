@@ -155,11 +155,11 @@ class VideoSource : public FrameSource {
   std::atomic<std::uint64_t> rateDrops_{0};
   std::atomic<std::uint64_t> backendDrops_{0};
   std::atomic<std::int64_t> lastKeptPts_{INT64_MIN};  // for the frame-rate limit (one producer)
-  std::atomic<std::int64_t> minInterval_{0};         // ns between kept frames (0: keep all)
-  std::atomic<std::int64_t> lastDelivery_{0};        // Clock time of the last frame delivered
+  std::atomic<std::int64_t> minInterval_{0};          // ns between kept frames (0: keep all)
+  std::atomic<std::int64_t> lastDelivery_{0};         // Clock time of the last frame delivered
   std::atomic<std::int64_t> stallTimeout_{2'000'000'000};
-  std::atomic<bool> stalled_{false};                 // lost because nothing came for stallTimeout_
-  mutable std::mutex mutex_;                          // guards the fields below
+  std::atomic<bool> stalled_{false};  // lost because nothing came for stallTimeout_
+  mutable std::mutex mutex_;          // guards the fields below
   VideoMode mode_;
   std::vector<VideoMode> modes_;
   VideoControls controls_;

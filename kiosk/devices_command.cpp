@@ -47,7 +47,8 @@ int devicesMain(std::span<const std::string_view> args) {
   std::vector<std::string> replays;
   bool synthetic = false;
   for (const ParsedOption& o : *parsed) {
-    if (o.name.empty()) return usageError(fmt::format("unexpected argument '{}'; see 'basalt devices --help'", o.value));
+    if (o.name.empty())
+      return usageError(fmt::format("unexpected argument '{}'; see 'basalt devices --help'", o.value));
     if (o.name == "--help") {
       fmt::print("{}", devicesUsage());
       return 0;

@@ -74,7 +74,8 @@ int recordMain(std::span<const std::string_view> args) {
         const int n = isDial ? ++dials : ++cameras;
         std::string name = isDial ? "dials" : "camera";
         if (n > 1) name += std::to_string(n);
-        auto r = parseDeviceSpec(spec, isDial ? devices::DeviceKind::kDialBox : devices::DeviceKind::kVideoSource, name);
+        auto r =
+            parseDeviceSpec(spec, isDial ? devices::DeviceKind::kDialBox : devices::DeviceKind::kVideoSource, name);
         if (!r) return std::unexpected(r.error());
         requests.push_back(std::move(*r));
         return {};

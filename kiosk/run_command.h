@@ -30,7 +30,7 @@ struct RunOptions {
   double fps = 60;
   ClockMode clock = ClockMode::kAuto;
   std::optional<std::filesystem::path> replay;  ///< a trace folder or hid-recorder file to replay
-  bool replayOnce = false;                       ///< play it once instead of looping
+  bool replayOnce = false;                      ///< play it once instead of looping
 };
 
 /// \brief Parses the arguments after `run`.

@@ -10,9 +10,14 @@ constexpr struct {
   Action action;
   std::string_view name;
 } kActionNames[] = {
-    {Action::kNone, "none"},         {Action::kRotateX, "rotate_x"},       {Action::kRotateY, "rotate_y"},
-    {Action::kRotateZ, "rotate_z"},  {Action::kScale, "scale"},            {Action::kTranslateX, "translate_x"},
-    {Action::kTranslateY, "translate_y"}, {Action::kTranslateZ, "translate_z"},
+    {Action::kNone, "none"},
+    {Action::kRotateX, "rotate_x"},
+    {Action::kRotateY, "rotate_y"},
+    {Action::kRotateZ, "rotate_z"},
+    {Action::kScale, "scale"},
+    {Action::kTranslateX, "translate_x"},
+    {Action::kTranslateY, "translate_y"},
+    {Action::kTranslateZ, "translate_z"},
 };
 
 // Turns further apart than this count as a fresh, slow turn for acceleration.
@@ -63,7 +68,8 @@ bool Bindings::turn(std::size_t dial, double turns, Nanos time, Show& show, bool
   double factor = 1;
   if (accelerate && b.acceleration != 0) {
     DialState& s = state_[dial];
-    const double gap = s.lastTime.count() < 0 ? kSlowGapSeconds : std::min(kSlowGapSeconds, toSeconds(time - s.lastTime));
+    const double gap =
+        s.lastTime.count() < 0 ? kSlowGapSeconds : std::min(kSlowGapSeconds, toSeconds(time - s.lastTime));
     const double speed = std::abs(turns) / std::max(gap, 1e-3);
     factor = 1 + b.acceleration * speed;
     s.lastTime = time;

@@ -22,14 +22,8 @@ Yuv toYuv(Rgb8 c) {
           static_cast<std::uint8_t>(std::clamp(v, 0, 255))};
 }
 
-constexpr std::array<Rgb8, 8> kBars = {{{191, 191, 191},
-                                        {191, 191, 0},
-                                        {0, 191, 191},
-                                        {0, 191, 0},
-                                        {191, 0, 191},
-                                        {191, 0, 0},
-                                        {0, 0, 191},
-                                        {0, 0, 0}}};
+constexpr std::array<Rgb8, 8> kBars = {
+    {{191, 191, 191}, {191, 191, 0}, {0, 191, 191}, {0, 191, 0}, {191, 0, 191}, {191, 0, 0}, {0, 0, 191}, {0, 0, 0}}};
 
 /// The pattern's colour at (x, y), before the moving box.
 Rgb8 patternColour(TestPattern pattern, std::uint32_t x, std::uint32_t y, std::uint32_t w, std::uint32_t h,

@@ -194,7 +194,8 @@ Result<HidRecording> readHidRecording(const std::filesystem::path& path) {
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) return fail(Errc::kNotFound, "cannot read the recording: " + ec.message(), path.string());
-  if (size > (std::uintmax_t{256} << 20)) return fail(Errc::kResourceExhausted, "the recording is over 256 MiB", path.string());
+  if (size > (std::uintmax_t{256} << 20))
+    return fail(Errc::kResourceExhausted, "the recording is over 256 MiB", path.string());
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(Errc::kIo, "cannot open the recording", path.string());
   std::ostringstream text;

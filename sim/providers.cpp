@@ -38,10 +38,10 @@ Result<void> applyCameraOptions(const devices::DeviceRequest& request, Synthetic
       if (pixelFormatName(static_cast<PixelFormat>(i)) == format) f = static_cast<PixelFormat>(i);
     }
     if (f == PixelFormat::kUnknown) {
-      return fail(Errc::kInvalidArgument,
-                  fmt::format("format '{}' is not one of RGBA, BGRA, RGB, GRAY8, I420, YV12, NV12, NV21, YUYV, UYVY",
-                              format),
-                  where(request));
+      return fail(
+          Errc::kInvalidArgument,
+          fmt::format("format '{}' is not one of RGBA, BGRA, RGB, GRAY8, I420, YV12, NV12, NV21, YUYV, UYVY", format),
+          where(request));
     }
     config.mode.format = f;
   }
@@ -97,7 +97,8 @@ std::vector<ScriptedInput> SyntheticProvider::demoScript() {
 
 SyntheticProvider::SyntheticProvider() {
   Device dial;
-  dial.candidate = {SyntheticDial::defaultInfo(), devices::DeviceKind::kDialBox, "", "scripted turns: 8 dials, 32 buttons"};
+  dial.candidate = {SyntheticDial::defaultInfo(), devices::DeviceKind::kDialBox, "",
+                    "scripted turns: 8 dials, 32 buttons"};
   dial.script = demoScript();
   Device camera;
   camera.candidate = {SyntheticCamera::defaultInfo(), devices::DeviceKind::kVideoSource, "",

@@ -36,7 +36,7 @@ class SyntheticProvider final : public devices::DeviceProvider {
     devices::DeviceCandidate candidate;
     std::vector<ScriptedInput> script;  ///< dial boxes
     bool loop = true;
-    SyntheticCameraConfig camera;       ///< cameras
+    SyntheticCameraConfig camera;  ///< cameras
   };
 
   /// \brief With the default dial box and camera.
@@ -105,7 +105,7 @@ class ReplayProvider final : public devices::DeviceProvider {
   struct Entry {
     std::string requestName;
     devices::DeviceCandidate candidate;
-    HidRecordedDevice hid;       // dial boxes
+    HidRecordedDevice hid;        // dial boxes
     std::filesystem::path video;  // video sources
   };
   TraceVideoReaderFactory videoReader_;

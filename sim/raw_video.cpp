@@ -93,13 +93,13 @@ Result<std::unique_ptr<RawVideoReader>> RawVideoReader::open(const std::filesyst
   char magic[8];
   std::uint32_t format = 0;
   devices::VideoMode mode;
-  if (std::fread(magic, 1, 8, f) != 8 || std::memcmp(magic, kMagic, 8) != 0 || !get(f, format) ||
-      !get(f, mode.width) || !get(f, mode.height) || !get(f, mode.fps)) {
+  if (std::fread(magic, 1, 8, f) != 8 || std::memcmp(magic, kMagic, 8) != 0 || !get(f, format) || !get(f, mode.width) ||
+      !get(f, mode.height) || !get(f, mode.fps)) {
     std::fclose(f);
     return fail(Errc::kParse, "not a Basalt raw trace video (.bvraw)", path.string());
   }
-  if (format == 0 || format > static_cast<std::uint32_t>(PixelFormat::kMjpeg) || mode.width == 0 ||
-      mode.height == 0 || mode.width > kMaxDimension || mode.height > kMaxDimension || !(mode.fps >= 0)) {
+  if (format == 0 || format > static_cast<std::uint32_t>(PixelFormat::kMjpeg) || mode.width == 0 || mode.height == 0 ||
+      mode.width > kMaxDimension || mode.height > kMaxDimension || !(mode.fps >= 0)) {
     std::fclose(f);
     return fail(Errc::kParse, "the trace video header is damaged", path.string());
   }

@@ -18,11 +18,12 @@ Result<std::unique_ptr<ReplayDialBox>> ReplayDialBox::create(devices::DeviceInfo
                                                              bool loop) {
   auto decoder = devices::DialDecoder::create(recording.vendor, recording.product, recording.descriptor, info.path);
   if (!decoder) return std::unexpected(decoder.error());
-  return std::unique_ptr<ReplayDialBox>(new ReplayDialBox(std::move(info), recording, std::move(*decoder), clock, loop));
+  return std::unique_ptr<ReplayDialBox>(
+      new ReplayDialBox(std::move(info), recording, std::move(*decoder), clock, loop));
 }
 
-ReplayDialBox::ReplayDialBox(devices::DeviceInfo info, const HidRecordedDevice& recording,
-                             devices::DialDecoder decoder, const Clock& clock, bool loop)
+ReplayDialBox::ReplayDialBox(devices::DeviceInfo info, const HidRecordedDevice& recording, devices::DialDecoder decoder,
+                             const Clock& clock, bool loop)
     : DialBox(std::move(info), decoder.dialCount(), decoder.buttonCount(), true),
       reports_(recording.reports),
       decoder_(std::move(decoder)),

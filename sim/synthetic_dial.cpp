@@ -15,9 +15,13 @@ devices::DeviceInfo SyntheticDial::defaultInfo() {
 SyntheticDial::SyntheticDial(std::vector<ScriptedInput> script, const Clock& clock, bool loop)
     : SyntheticDial(defaultInfo(), std::move(script), clock, loop, nullptr) {}
 
-SyntheticDial::SyntheticDial(devices::DeviceInfo info, std::vector<ScriptedInput> script, const Clock& clock,
-                             bool loop, PresenceFlag present)
-    : DialBox(std::move(info), 8, 32), script_(std::move(script)), clock_(clock), loop_(loop), present_(std::move(present)) {}
+SyntheticDial::SyntheticDial(devices::DeviceInfo info, std::vector<ScriptedInput> script, const Clock& clock, bool loop,
+                             PresenceFlag present)
+    : DialBox(std::move(info), 8, 32),
+      script_(std::move(script)),
+      clock_(clock),
+      loop_(loop),
+      present_(std::move(present)) {}
 
 Result<void> SyntheticDial::doOpen() {
   if (present_ && !present_->load()) {

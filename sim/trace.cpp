@@ -189,8 +189,7 @@ Result<TraceInfo> parseTraceToml(std::string_view text, std::string_view name) {
   std::size_t pos = 0;
   while (pos <= text.size()) {
     const std::size_t nl = text.find('\n', pos);
-    const std::string_view line =
-        trim(text.substr(pos, nl == std::string_view::npos ? text.size() - pos : nl - pos));
+    const std::string_view line = trim(text.substr(pos, nl == std::string_view::npos ? text.size() - pos : nl - pos));
     pos = nl == std::string_view::npos ? text.size() + 1 : nl + 1;
     ++lineNo;
     if (line.empty() || line.front() == '#') continue;
@@ -334,8 +333,7 @@ Result<std::unique_ptr<TraceRecorder>> TraceRecorder::create(const std::filesyst
                                                              Options options) {
   std::error_code ec;
   if (std::filesystem::exists(folder, ec) && !std::filesystem::is_empty(folder, ec)) {
-    return fail(Errc::kInvalidArgument, "the trace folder exists and is not empty; choose a new name",
-                folder.string());
+    return fail(Errc::kInvalidArgument, "the trace folder exists and is not empty; choose a new name", folder.string());
   }
   std::filesystem::create_directories(folder, ec);
   if (ec) return fail(Errc::kIo, "cannot create the trace folder: " + ec.message(), folder.string());
@@ -412,7 +410,8 @@ void TraceRecorder::onReport(DeviceId device, Nanos time, std::span<const std::u
   auto it = dials_.find(device);
   if (it == dials_.end()) return;
   it->second.out << HidRecordingWriter::reportLine(time - start_, report);
-  if (!it->second.out) noteError(Error(Errc::kIo, "cannot write the recording (disk full?)", info_.devices[it->second.index].file));
+  if (!it->second.out)
+    noteError(Error(Errc::kIo, "cannot write the recording (disk full?)", info_.devices[it->second.index].file));
   ++reports_;
   lastTime_ = std::max(lastTime_, time - start_);
 }

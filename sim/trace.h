@@ -32,8 +32,8 @@ namespace basalt::sim {
 struct TraceDevice {
   std::string name;  ///< the show's name for it ("dials")
   devices::DeviceKind kind = devices::DeviceKind::kDialBox;
-  devices::DeviceInfo info;  ///< identity at recording time
-  std::string file;          ///< relative to the trace folder
+  devices::DeviceInfo info;              ///< identity at recording time
+  std::string file;                      ///< relative to the trace folder
   std::vector<std::uint8_t> descriptor;  ///< dial boxes: the report descriptor
   devices::VideoMode mode;               ///< video sources
 };
@@ -42,9 +42,9 @@ struct TraceInfo {
   std::filesystem::path folder;
   std::string recorded;  ///< ISO 8601 UTC
   std::string host;
-  std::string basalt;    ///< version that wrote it
-  double fps = 0;        ///< the show's frame rate while recording
-  double seconds = 0;    ///< length
+  std::string basalt;  ///< version that wrote it
+  double fps = 0;      ///< the show's frame rate while recording
+  double seconds = 0;  ///< length
   std::vector<TraceDevice> devices;
 };
 

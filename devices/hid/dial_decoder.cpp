@@ -55,8 +55,8 @@ std::string_view dialProfileName(DialProfile profile) {
 
 DialProfile profileFor(std::uint16_t vendor, std::uint16_t product) {
   if (vendor == kGriffinVendor && product == kPowerMateProduct) return DialProfile::kPowerMate;
-  if (vendor == kContourVendor && (product == kShuttleProV1Product || product == kShuttleXpressProduct ||
-                                   product == kShuttleProV2Product)) {
+  if (vendor == kContourVendor &&
+      (product == kShuttleProV1Product || product == kShuttleXpressProduct || product == kShuttleProV2Product)) {
     return DialProfile::kShuttle;
   }
   return DialProfile::kGenericHid;
@@ -142,8 +142,8 @@ Result<DialDecoder> DialDecoder::create(std::uint16_t vendor, std::uint16_t prod
         candidates.push_back({rank, candidates.size(), c, usage});
       }
     } else {
-      const bool consumer = (f.usages.empty() ? hid::usagePage(f.usageMin) : hid::usagePage(f.usages.front())) ==
-                            u::kConsumer;
+      const bool consumer =
+          (f.usages.empty() ? hid::usagePage(f.usageMin) : hid::usagePage(f.usages.front())) == u::kConsumer;
       if (consumer) {
         d.buttons_.push_back({fi, 0, true, 0});
         consumerArray = true;
@@ -196,7 +196,8 @@ std::size_t DialDecoder::decodePowerMate(std::span<const std::uint8_t> report, s
     out[n++] = Event{Nanos{0}, 0, EventKind::kButton, 0, down ? 1.0 : 0.0};
   }
   const auto delta = static_cast<std::int8_t>(report[1]);
-  if (delta != 0 && n < out.size()) out[n++] = Event{Nanos{0}, 0, EventKind::kDialDelta, 0, delta / kPowerMateCountsPerTurn};
+  if (delta != 0 && n < out.size())
+    out[n++] = Event{Nanos{0}, 0, EventKind::kDialDelta, 0, delta / kPowerMateCountsPerTurn};
   return n;
 }
 
@@ -247,14 +248,16 @@ std::size_t DialDecoder::decodeGeneric(std::span<const std::uint8_t> report, std
     if ((v < f.logicalMin || v > f.logicalMax)) continue;  // null state or out of range: no reading
     if (n >= out.size()) break;
     if (c.kind == EventKind::kDialDelta && !c.wrapAbsolute) {
-      if (v != 0) out[n++] = Event{Nanos{0}, 0, EventKind::kDialDelta, c.index, static_cast<double>(v) / c.countsPerTurn};
+      if (v != 0)
+        out[n++] = Event{Nanos{0}, 0, EventKind::kDialDelta, c.index, static_cast<double>(v) / c.countsPerTurn};
     } else if (c.wrapAbsolute) {
       if (c.haveLast) {
         const std::int64_t range = std::int64_t{f.logicalMax} - f.logicalMin + 1;
         std::int64_t d = v - c.last;
         if (d > range / 2) d -= range;
         if (d < -range / 2) d += range;
-        if (d != 0) out[n++] = Event{Nanos{0}, 0, EventKind::kDialDelta, c.index, static_cast<double>(d) / c.countsPerTurn};
+        if (d != 0)
+          out[n++] = Event{Nanos{0}, 0, EventKind::kDialDelta, c.index, static_cast<double>(d) / c.countsPerTurn};
       }
     } else if (!c.haveLast || v != c.last) {
       const double span = static_cast<double>(f.logicalMax) - f.logicalMin;
@@ -307,30 +310,30 @@ std::size_t DialDecoder::decodeGeneric(std::span<const std::uint8_t> report, std
 
 const std::vector<std::uint8_t>& virtualDialBoxDescriptor() {
   static const std::vector<std::uint8_t> kDescriptor = {
-      0x05, 0x01,        // Usage Page (Generic Desktop)
-      0x09, 0x08,        // Usage (Multi-axis Controller)
-      0xa1, 0x01,        // Collection (Application)
-      0x85, 0x01,        //   Report ID (1)
+      0x05, 0x01,                                      // Usage Page (Generic Desktop)
+      0x09, 0x08,                                      // Usage (Multi-axis Controller)
+      0xa1, 0x01,                                      // Collection (Application)
+      0x85, 0x01,                                      //   Report ID (1)
       0x09, 0x37, 0x09, 0x37, 0x09, 0x37, 0x09, 0x37,  // Usage (Dial) x 8
       0x09, 0x37, 0x09, 0x37, 0x09, 0x37, 0x09, 0x37,  //
-      0x16, 0x01, 0x80,  //   Logical Minimum (-32767)
-      0x26, 0xff, 0x7f,  //   Logical Maximum (32767)
-      0x55, 0x0f,        //   Unit Exponent (-1)
-      0x65, 0x14,        //   Unit (English Rotation: degrees)
-      0x75, 0x10,        //   Report Size (16)
-      0x95, 0x08,        //   Report Count (8)
-      0x81, 0x06,        //   Input (Data, Variable, Relative)
-      0x55, 0x00,        //   Unit Exponent (0)
-      0x65, 0x00,        //   Unit (none)
-      0x05, 0x09,        //   Usage Page (Button)
-      0x19, 0x01,        //   Usage Minimum (1)
-      0x29, 0x20,        //   Usage Maximum (32)
-      0x15, 0x00,        //   Logical Minimum (0)
-      0x25, 0x01,        //   Logical Maximum (1)
-      0x75, 0x01,        //   Report Size (1)
-      0x95, 0x20,        //   Report Count (32)
-      0x81, 0x02,        //   Input (Data, Variable, Absolute)
-      0xc0,              // End Collection
+      0x16, 0x01, 0x80,                                //   Logical Minimum (-32767)
+      0x26, 0xff, 0x7f,                                //   Logical Maximum (32767)
+      0x55, 0x0f,                                      //   Unit Exponent (-1)
+      0x65, 0x14,                                      //   Unit (English Rotation: degrees)
+      0x75, 0x10,                                      //   Report Size (16)
+      0x95, 0x08,                                      //   Report Count (8)
+      0x81, 0x06,                                      //   Input (Data, Variable, Relative)
+      0x55, 0x00,                                      //   Unit Exponent (0)
+      0x65, 0x00,                                      //   Unit (none)
+      0x05, 0x09,                                      //   Usage Page (Button)
+      0x19, 0x01,                                      //   Usage Minimum (1)
+      0x29, 0x20,                                      //   Usage Maximum (32)
+      0x15, 0x00,                                      //   Logical Minimum (0)
+      0x25, 0x01,                                      //   Logical Maximum (1)
+      0x75, 0x01,                                      //   Report Size (1)
+      0x95, 0x20,                                      //   Report Count (32)
+      0x81, 0x02,                                      //   Input (Data, Variable, Absolute)
+      0xc0,                                            // End Collection
   };
   return kDescriptor;
 }
@@ -339,7 +342,8 @@ void VirtualReportEncoder::encode(const Event& event, const Sink& sink) {
   std::array<std::uint8_t, 21> report{};
   report[0] = 1;
   auto putButtons = [&] {
-    for (int i = 0; i < 4; ++i) report[17 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(buttons_ >> (8 * i));
+    for (int i = 0; i < 4; ++i)
+      report[17 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(buttons_ >> (8 * i));
   };
   if (event.kind == EventKind::kButton && event.index < 32) {
     const std::uint32_t bit = 1u << event.index;

@@ -126,8 +126,8 @@ class HidrawDialBox final : public DialBox {
 
 Result<std::vector<std::uint8_t>> readHidrawDescriptor(const std::string& devnode) {
   const std::filesystem::path node(devnode);
-  const std::filesystem::path sys = std::filesystem::path("/sys/class/hidraw") / node.filename() / "device" /
-                                    "report_descriptor";
+  const std::filesystem::path sys =
+      std::filesystem::path("/sys/class/hidraw") / node.filename() / "device" / "report_descriptor";
   std::ifstream in(sys, std::ios::binary);
   if (!in) return fail(Errc::kNotFound, fmt::format("cannot read {}", sys.string()), devnode);
   std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -168,12 +168,14 @@ std::vector<DeviceCandidate> HidProvider::enumerate() {
     for (hid_device_info* d = list.get(); d; d = d->next) {
       DeviceCandidate c;
       c.kind = DeviceKind::kDialBox;
-      c.info = DeviceInfo{narrow(d->product_string), "hid", busOf(d->bus_type), d->vendor_id, d->product_id,
-                          d->path ? d->path : "", narrow(d->serial_number)};
+      c.info = DeviceInfo{
+          narrow(d->product_string), "hid", busOf(d->bus_type), d->vendor_id, d->product_id, d->path ? d->path : "",
+          narrow(d->serial_number)};
       auto descriptor = readHidrawDescriptor(c.info.path);
       if (!descriptor) {
         c.problem = descriptor.error().describe();
-      } else if (auto decoder = DialDecoder::create(c.info.vendor, c.info.product, *descriptor, c.info.path); !decoder) {
+      } else if (auto decoder = DialDecoder::create(c.info.vendor, c.info.product, *descriptor, c.info.path);
+                 !decoder) {
         c.problem = fmt::format("not a dial box: {}", decoder.error().message());
       } else {
         c.usage = fmt::format("{}: {} dial(s), {} button(s)", dialProfileName(decoder->profile()), decoder->dialCount(),
@@ -190,7 +192,7 @@ std::vector<DeviceCandidate> HidProvider::enumerate() {
 }
 
 Result<std::unique_ptr<DialBox>> HidProvider::openDialBox(const DeviceCandidate& candidate, const DeviceRequest&,
-                                                         const Clock& clock) {
+                                                          const Clock& clock) {
   return candidate.info.path.starts_with("usb:") ? openPowerMate(candidate.info.path, clock)
                                                  : openHidrawDialBox(candidate.info.path, clock);
 }

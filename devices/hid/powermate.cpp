@@ -62,9 +62,8 @@ std::string usbNode(libusb_device* dev) {
 }
 
 // A descriptor for the PowerMate's 6-byte vendor report, for recordings when GET_DESCRIPTOR fails.
-const std::vector<std::uint8_t> kFallbackDescriptor = {0x06, 0x00, 0xff, 0x09, 0x01, 0xa1, 0x01, 0x15, 0x00, 0x26,
-                                                       0xff, 0x00, 0x75, 0x08, 0x95, 0x06, 0x09, 0x01, 0x81, 0x02,
-                                                       0xc0};
+const std::vector<std::uint8_t> kFallbackDescriptor = {0x06, 0x00, 0xff, 0x09, 0x01, 0xa1, 0x01, 0x15, 0x00, 0x26, 0xff,
+                                                       0x00, 0x75, 0x08, 0x95, 0x06, 0x09, 0x01, 0x81, 0x02, 0xc0};
 
 class PowerMateDialBox final : public DialBox {
  public:
@@ -101,10 +100,10 @@ class PowerMateDialBox final : public DialBox {
     HandlePtr handle(h);
     libusb_set_auto_detach_kernel_driver(h, 1);
     if (const int rc = libusb_claim_interface(h, 0); rc != 0) {
-      return fail(rc == LIBUSB_ERROR_BUSY ? Errc::kUnavailable : Errc::kIo,
-                  fmt::format("cannot claim the interface: {} (is another program using the PowerMate?)",
-                              libusb_strerror(rc)),
-                  info().path);
+      return fail(
+          rc == LIBUSB_ERROR_BUSY ? Errc::kUnavailable : Errc::kIo,
+          fmt::format("cannot claim the interface: {} (is another program using the PowerMate?)", libusb_strerror(rc)),
+          info().path);
     }
     endpoint_ = 0x81;
     libusb_config_descriptor* cfg = nullptr;
@@ -221,8 +220,8 @@ Result<std::unique_ptr<DialBox>> openPowerMate(const std::string& path, const Cl
     if (all.empty()) return fail(Errc::kNotFound, "no Griffin PowerMate (077d:0410) on USB", "usb");
     chosen = all.front().info.path;
   }
-  return std::unique_ptr<DialBox>(
-      std::make_unique<PowerMateDialBox>(DeviceInfo{"Griffin PowerMate", "hid", "usb", kGriffinVendor, kPowerMateProduct, chosen, ""}, clock));
+  return std::unique_ptr<DialBox>(std::make_unique<PowerMateDialBox>(
+      DeviceInfo{"Griffin PowerMate", "hid", "usb", kGriffinVendor, kPowerMateProduct, chosen, ""}, clock));
 }
 
 }  // namespace basalt::devices

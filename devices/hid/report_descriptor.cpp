@@ -119,7 +119,7 @@ Result<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> byt
   Globals g;
   std::vector<Globals> stack;
   Locals locals;
-  std::vector<int> open;  // indices of open collections
+  std::vector<int> open;                            // indices of open collections
   std::map<std::uint32_t, std::uint32_t> bitsUsed;  // (type << 8 | id) -> bits so far
 
   std::size_t pos = 0;
@@ -147,7 +147,8 @@ Result<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> byt
 
     if (type == 0) {  // main
       if (tag == 0x8 || tag == 0x9 || tag == 0xb) {
-        const ReportType rtype = tag == 0x8 ? ReportType::kInput : (tag == 0x9 ? ReportType::kOutput : ReportType::kFeature);
+        const ReportType rtype =
+            tag == 0x8 ? ReportType::kInput : (tag == 0x9 ? ReportType::kOutput : ReportType::kFeature);
         if (g.reportSize > kMaxReportSize) {
           return bad(itemStart, fmt::format("Report Size {} bits is more than {}", g.reportSize, kMaxReportSize));
         }
@@ -245,7 +246,7 @@ Result<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> byt
           // HID 1.11 stores the exponent as a 4-bit two's complement nibble; some devices use a
           // whole signed byte.
           g.unitExponent = value <= 0xf ? static_cast<std::int8_t>(value >= 8 ? static_cast<int>(value) - 16
-                                                                                : static_cast<int>(value))
+                                                                              : static_cast<int>(value))
                                         : static_cast<std::int8_t>(svalue);
           break;
         case 0x6: g.unit = value; break;

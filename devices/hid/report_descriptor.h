@@ -79,7 +79,7 @@ struct ReportField {
   std::vector<std::uint32_t> usages;
   std::uint32_t usageMin = 0;  ///< array fields declared with a usage range
   std::uint32_t usageMax = 0;
-  int collection = -1;          ///< innermost enclosing collection
+  int collection = -1;            ///< innermost enclosing collection
   std::uint32_t application = 0;  ///< usage of the enclosing application collection
 
   [[nodiscard]] bool isConstant() const { return (flags & field_flags::kConstant) != 0; }

@@ -37,10 +37,10 @@ struct FormatPair {
 
 const std::vector<FormatPair>& formatTable() {
   static const std::vector<FormatPair> table = {
-      {PixelFormat::kYuyv, lc::formats::YUYV},    {PixelFormat::kUyvy, lc::formats::UYVY},
-      {PixelFormat::kNv12, lc::formats::NV12},    {PixelFormat::kNv21, lc::formats::NV21},
-      {PixelFormat::kI420, lc::formats::YUV420},  {PixelFormat::kYv12, lc::formats::YVU420},
-      {PixelFormat::kMjpeg, lc::formats::MJPEG},  {PixelFormat::kGray8, lc::formats::R8},
+      {PixelFormat::kYuyv, lc::formats::YUYV},      {PixelFormat::kUyvy, lc::formats::UYVY},
+      {PixelFormat::kNv12, lc::formats::NV12},      {PixelFormat::kNv21, lc::formats::NV21},
+      {PixelFormat::kI420, lc::formats::YUV420},    {PixelFormat::kYv12, lc::formats::YVU420},
+      {PixelFormat::kMjpeg, lc::formats::MJPEG},    {PixelFormat::kGray8, lc::formats::R8},
       {PixelFormat::kRgba8, lc::formats::XBGR8888}, {PixelFormat::kBgra8, lc::formats::XRGB8888},
       {PixelFormat::kRgb8, lc::formats::BGR888},
   };
@@ -162,14 +162,16 @@ class LibcameraCamera final : public VideoSource {
     }
     if (options_.width && options_.height) sc.size = lc::Size(options_.width, options_.height);
     sc.bufferCount = std::max(sc.bufferCount, 4u);
-    if (session->config_->validate() == lc::CameraConfiguration::Invalid || camera->configure(session->config_.get()) != 0) {
+    if (session->config_->validate() == lc::CameraConfiguration::Invalid ||
+        camera->configure(session->config_.get()) != 0) {
       cleanup();
       return fail(Errc::kUnsupported, fmt::format("the camera refused {}", sc.toString()), id);
     }
     const PixelFormat format = fromLibcamera(sc.pixelFormat);
     if (format == PixelFormat::kUnknown) {
       cleanup();
-      return fail(Errc::kUnsupported, fmt::format("the camera chose {}, which Basalt cannot show", sc.pixelFormat.toString()), id);
+      return fail(Errc::kUnsupported,
+                  fmt::format("the camera chose {}, which Basalt cannot show", sc.pixelFormat.toString()), id);
     }
     session->stream_ = sc.stream();
     session->allocator_ = std::make_unique<lc::FrameBufferAllocator>(camera);
@@ -261,9 +263,12 @@ class LibcameraCamera final : public VideoSource {
       const std::size_t src = std::min<std::size_t>(static_cast<std::size_t>(i), planes.size() - 1);
       const std::uint32_t stride =
           i == 0 || mode_.format == PixelFormat::kNv12 || mode_.format == PixelFormat::kNv21 ? stride_ : stride_ / 2;
-      const std::size_t offset = planes.size() > 1 ? planes[src].offset
-                                                   : planes[0].offset + (i == 0 ? 0 : std::size_t{stride_} * mode_.height +
-                                                                                           (i == 2 ? std::size_t{stride} * ((mode_.height + 1) / 2) : 0));
+      const std::size_t offset =
+          planes.size() > 1
+              ? planes[src].offset
+              : planes[0].offset + (i == 0 ? 0
+                                           : std::size_t{stride_} * mode_.height +
+                                                 (i == 2 ? std::size_t{stride} * ((mode_.height + 1) / 2) : 0));
       p.data = static_cast<std::uint8_t*>(maps[src].first) + offset;
       p.stride = stride;
       p.offset = static_cast<std::uint32_t>(offset);

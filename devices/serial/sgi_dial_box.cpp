@@ -72,10 +72,12 @@ std::size_t SgiBoxDecoder::feed(std::span<const std::uint8_t> bytes, std::span<E
         have_ = 0;
         const int dial = pending_[0] - 0x30;
         const auto value = static_cast<std::uint16_t>(pending_[1] << 8 | pending_[2]);
-        const auto delta = static_cast<std::int16_t>(static_cast<std::uint16_t>(value - counts_[static_cast<std::size_t>(dial)]));
+        const auto delta =
+            static_cast<std::int16_t>(static_cast<std::uint16_t>(value - counts_[static_cast<std::size_t>(dial)]));
         counts_[static_cast<std::size_t>(dial)] = value;
         if (delta != 0 && n < out.size()) {
-          out[n++] = Event{Nanos{0}, 0, EventKind::kDialDelta, static_cast<std::uint16_t>(dial), delta / kSgiCountsPerTurn};
+          out[n++] =
+              Event{Nanos{0}, 0, EventKind::kDialDelta, static_cast<std::uint16_t>(dial), delta / kSgiCountsPerTurn};
         }
       }
       continue;
@@ -95,7 +97,8 @@ std::size_t SgiBoxDecoder::feed(std::span<const std::uint8_t> bytes, std::span<E
       ++unknown_;
       continue;
     }
-    if (n < out.size()) out[n++] = Event{Nanos{0}, 0, EventKind::kButton, static_cast<std::uint16_t>(button), pressed ? 1.0 : 0.0};
+    if (n < out.size())
+      out[n++] = Event{Nanos{0}, 0, EventKind::kButton, static_cast<std::uint16_t>(button), pressed ? 1.0 : 0.0};
   }
   return n;
 }
@@ -147,7 +150,8 @@ Result<void> SgiDialBox::doOpen() {
     const Nanos left = deadline - clock_.now();
     if (left <= Nanos{0}) break;
     pollfd p{fd.get(), POLLIN, 0};
-    const int ms = static_cast<int>(std::min<std::int64_t>(std::chrono::duration_cast<std::chrono::milliseconds>(left).count() + 1, 100));
+    const int ms = static_cast<int>(
+        std::min<std::int64_t>(std::chrono::duration_cast<std::chrono::milliseconds>(left).count() + 1, 100));
     if (::poll(&p, 1, ms) < 0 && errno != EINTR) break;
     if (!(p.revents & POLLIN)) {
       if (p.revents & (POLLHUP | POLLERR)) break;
@@ -199,7 +203,8 @@ void SgiDialBox::readLoop() {
     const ssize_t n = ::read(fd_.get(), buf, sizeof buf);
     if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
     if (n <= 0) {
-      reportLost(Error(Errc::kDeviceLost, n == 0 ? std::string("the serial line closed") : systemErrorText("read failed", errno), path_));
+      reportLost(Error(Errc::kDeviceLost,
+                       n == 0 ? std::string("the serial line closed") : systemErrorText("read failed", errno), path_));
       return;
     }
     const Nanos now = clock_.now();
@@ -256,7 +261,7 @@ std::vector<DeviceCandidate> SerialProvider::enumerate() {
 }
 
 Result<std::unique_ptr<DialBox>> SerialProvider::openDialBox(const DeviceCandidate& candidate,
-                                                            const DeviceRequest& request, const Clock& clock) {
+                                                             const DeviceRequest& request, const Clock& clock) {
   Nanos timeout = std::chrono::milliseconds(1000);
   if (auto it = request.options.find("reset_timeout_ms"); it != request.options.end()) {
     int ms = 0;

@@ -113,8 +113,10 @@ int formatRank(PixelFormat f) {
 
 Colorimetry colorimetryOf(const v4l2_pix_format& p) {
   Colorimetry c;
-  if (p.ycbcr_enc == V4L2_YCBCR_ENC_709 || p.colorspace == V4L2_COLORSPACE_REC709) c.matrix = Colorimetry::Matrix::kBt709;
-  if (p.ycbcr_enc == V4L2_YCBCR_ENC_BT2020 || p.colorspace == V4L2_COLORSPACE_BT2020) c.matrix = Colorimetry::Matrix::kBt2020;
+  if (p.ycbcr_enc == V4L2_YCBCR_ENC_709 || p.colorspace == V4L2_COLORSPACE_REC709)
+    c.matrix = Colorimetry::Matrix::kBt709;
+  if (p.ycbcr_enc == V4L2_YCBCR_ENC_BT2020 || p.colorspace == V4L2_COLORSPACE_BT2020)
+    c.matrix = Colorimetry::Matrix::kBt2020;
   const bool full = p.quantization == V4L2_QUANTIZATION_FULL_RANGE ||
                     (p.quantization == V4L2_QUANTIZATION_DEFAULT && p.colorspace == V4L2_COLORSPACE_JPEG);
   c.range = full ? Colorimetry::Range::kFull : Colorimetry::Range::kLimited;
@@ -123,10 +125,9 @@ Colorimetry colorimetryOf(const v4l2_pix_format& p) {
 
 Error sysError(const std::string& path, std::string_view what, int e) {
   if (e == EACCES || e == EPERM) {
-    return Error(Errc::kPermissionDenied,
-                 systemErrorText(what, e) +
-                     "; add the user to the 'video' group or install configs/udev/70-basalt.rules",
-                 path);
+    return Error(
+        Errc::kPermissionDenied,
+        systemErrorText(what, e) + "; add the user to the 'video' group or install configs/udev/70-basalt.rules", path);
   }
   if (e == ENODEV || e == ENXIO) return Error(Errc::kDeviceLost, systemErrorText(what, e), path);
   if (e == EBUSY) return Error(Errc::kUnavailable, systemErrorText(what, e) + " (another program is using it?)", path);
@@ -355,7 +356,8 @@ Result<void> V4l2Camera::negotiate(bool* noSignal) {
   }
   v4l2_format f{};
   f.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  if (xioctl(fd_.get(), VIDIOC_G_FMT, &f) != 0) return std::unexpected(sysError(path_, "cannot read the format", errno));
+  if (xioctl(fd_.get(), VIDIOC_G_FMT, &f) != 0)
+    return std::unexpected(sysError(path_, "cannot read the format", errno));
   f.fmt.pix.pixelformat = fourcc;
   if (width && height) {
     f.fmt.pix.width = width;
@@ -365,7 +367,8 @@ Result<void> V4l2Camera::negotiate(bool* noSignal) {
   f.fmt.pix.bytesperline = 0;
   if (xioctl(fd_.get(), VIDIOC_S_FMT, &f) != 0) return std::unexpected(sysError(path_, "cannot set the format", errno));
   if (f.fmt.pix.pixelformat != fourcc || fromFourcc(fourcc) == PixelFormat::kUnknown) {
-    return fail(Errc::kUnsupported, fmt::format("the driver chose {} instead", fourccText(f.fmt.pix.pixelformat)), path_);
+    return fail(Errc::kUnsupported, fmt::format("the driver chose {} instead", fourccText(f.fmt.pix.pixelformat)),
+                path_);
   }
   fmt_ = f.fmt.pix;
   double fps = options_.fps > 0 ? options_.fps : controls().maxFps;
@@ -487,9 +490,10 @@ bool V4l2Camera::dequeue() {
     const std::uint32_t stride = i == 0 || mode_.format == PixelFormat::kNv12 || mode_.format == PixelFormat::kNv21
                                      ? fmt_.bytesperline
                                      : fmt_.bytesperline / 2;
-    const std::size_t rows = layout.planes[static_cast<std::size_t>(i)].stride
-                                 ? layout.planes[static_cast<std::size_t>(i)].size / layout.planes[static_cast<std::size_t>(i)].stride
-                                 : 0;
+    const std::size_t rows =
+        layout.planes[static_cast<std::size_t>(i)].stride
+            ? layout.planes[static_cast<std::size_t>(i)].size / layout.planes[static_cast<std::size_t>(i)].stride
+            : 0;
     p.data = base + offset;
     p.stride = mode_.format == PixelFormat::kMjpeg ? 0 : stride;
     p.offset = static_cast<std::uint32_t>(offset);
@@ -625,12 +629,12 @@ Result<V4l2Description> describeV4l2Device(const std::string& path) {
     v4l2_input in{};
     in.index = i;
     if (xioctl(fd.get(), VIDIOC_ENUMINPUT, &in) != 0) break;
-    d.inputs.push_back({static_cast<int>(i), reinterpret_cast<const char*>(in.name),
-                        in.type == V4L2_INPUT_TYPE_CAMERA, (in.capabilities & V4L2_IN_CAP_DV_TIMINGS) != 0,
+    d.inputs.push_back({static_cast<int>(i), reinterpret_cast<const char*>(in.name), in.type == V4L2_INPUT_TYPE_CAMERA,
+                        (in.capabilities & V4L2_IN_CAP_DV_TIMINGS) != 0,
                         (in.status & (V4L2_IN_ST_NO_SIGNAL | V4L2_IN_ST_NO_SYNC)) != 0});
   }
   const std::uint32_t type = d.multiplanar && !(caps & V4L2_CAP_VIDEO_CAPTURE) ? V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE
-                                                                                 : V4L2_BUF_TYPE_VIDEO_CAPTURE;
+                                                                               : V4L2_BUF_TYPE_VIDEO_CAPTURE;
   for (std::uint32_t i = 0; i < 64; ++i) {
     v4l2_fmtdesc f{};
     f.index = i;
@@ -660,7 +664,8 @@ Result<V4l2Description> describeV4l2Device(const std::string& path) {
         iv.width = size.discrete.width;
         iv.height = size.discrete.height;
         if (xioctl(fd.get(), VIDIOC_ENUM_FRAMEINTERVALS, &iv) != 0 || iv.type != V4L2_FRMIVAL_TYPE_DISCRETE) break;
-        if (iv.discrete.numerator) best = std::max(best, static_cast<double>(iv.discrete.denominator) / iv.discrete.numerator);
+        if (iv.discrete.numerator)
+          best = std::max(best, static_cast<double>(iv.discrete.denominator) / iv.discrete.numerator);
       }
       d.modes.push_back({pf, size.discrete.width, size.discrete.height, best});
       any = true;
@@ -676,7 +681,9 @@ Result<V4l2Description> describeV4l2Device(const std::string& path) {
 
 Result<V4l2Options> v4l2OptionsFrom(const DeviceRequest& request) {
   V4l2Options o;
-  auto bad = [&](const std::string& what) { return fail(Errc::kInvalidArgument, what, fmt::format("device '{}'", request.name)); };
+  auto bad = [&](const std::string& what) {
+    return fail(Errc::kInvalidArgument, what, fmt::format("device '{}'", request.name));
+  };
   for (const auto& [key, value] : request.options) {
     if (key == "format") {
       PixelFormat f = PixelFormat::kUnknown;

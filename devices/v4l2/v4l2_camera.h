@@ -18,9 +18,9 @@ namespace basalt::devices {
 struct V4l2Input {
   int index = 0;
   std::string name;
-  bool camera = false;      ///< V4L2_INPUT_TYPE_CAMERA
-  bool dvTimings = false;   ///< HDMI-style input with the DV timings API (signal detection)
-  bool noSignal = false;    ///< the driver reports no signal now
+  bool camera = false;     ///< V4L2_INPUT_TYPE_CAMERA
+  bool dvTimings = false;  ///< HDMI-style input with the DV timings API (signal detection)
+  bool noSignal = false;   ///< the driver reports no signal now
 };
 
 /// \brief What a V4L2 capture node offers (for `basalt devices`, tests and mode choice).

@@ -49,21 +49,24 @@ TEST(V4l2Hardware, HdmiSignalLossAndResolutionChangeRenegotiate) {
   const VideoMode before = source->mode();
   // vivid: "DV Timings Signal Mode" 1 = no signal, 0 = current timings, 4 = selected timings.
   ASSERT_TRUE(setV4l2ControlByName(*node, "DV Timings Signal Mode", 1));
-  EXPECT_TRUE(waitFor(serviceAndDrain, [&] { return source->health().state == SourceState::kLost; }, 5s))
+  EXPECT_TRUE(waitFor(
+      serviceAndDrain, [&] { return source->health().state == SourceState::kLost; }, 5s))
       << "the signal went but the source stayed live";
   EXPECT_TRUE(source->recovering());
   ASSERT_TRUE(setV4l2ControlByName(*node, "DV Timings Signal Mode", 0));
   const auto delivered = source->framesDelivered();
-  EXPECT_TRUE(waitFor(serviceAndDrain,
-                      [&] { return source->health().state == SourceState::kLive && source->framesDelivered() > delivered + 2; },
-                      10s))
+  EXPECT_TRUE(waitFor(
+      serviceAndDrain,
+      [&] { return source->health().state == SourceState::kLive && source->framesDelivered() > delivered + 2; }, 10s))
       << "the signal came back but the stream did not";
   // Another resolution: pick a different entry of the "DV Timings" menu, then select it.
   bool changed = false;
   for (int entry = 1; entry < 8 && !changed; ++entry) {
     if (!setV4l2ControlByName(*node, "DV Timings", entry)) continue;
     if (!setV4l2ControlByName(*node, "DV Timings Signal Mode", 4)) break;
-    changed = waitFor(serviceAndDrain, [&] { return source->mode().width != before.width && source->health().state == SourceState::kLive; }, 5s);
+    changed = waitFor(
+        serviceAndDrain,
+        [&] { return source->mode().width != before.width && source->health().state == SourceState::kLive; }, 5s);
   }
   EXPECT_TRUE(changed) << "no resolution change was renegotiated";
   source->close();
@@ -110,7 +113,8 @@ void hotplugRoundTrip(DeviceKind kind, const std::string& gadget, DeviceMatch ma
   ASSERT_TRUE(gadgetCtl("unplug", gadget));
   EXPECT_TRUE(waitFor(idle, [&] { return state() == DeviceState::kLost || state() == DeviceState::kReopening; }, 10s));
   ASSERT_TRUE(gadgetCtl("plug", gadget));
-  EXPECT_TRUE(waitFor(idle, [&] { return state() == DeviceState::kLive; }, 20s))
+  EXPECT_TRUE(waitFor(
+      idle, [&] { return state() == DeviceState::kLive; }, 20s))
       << "not live again after the replug: " << manager.status()[0].lastError;
   manager.stop();
   if (monitor) (*monitor)->stop();

@@ -100,14 +100,16 @@ Made makeReplay(const Clock& clock, std::string& reason) {
   rec.descriptor = virtualDialBoxDescriptor();
   VirtualReportEncoder enc;
   int i = 0;
-  for (const Event& e : {Event{Nanos{0}, 0, EventKind::kDialDelta, 0, 0.1}, Event{Nanos{0}, 0, EventKind::kDialDelta, 1, -0.2},
-                         Event{Nanos{0}, 0, EventKind::kButton, 2, 1}, Event{Nanos{0}, 0, EventKind::kDialDelta, 7, 0.05}}) {
+  for (const Event& e :
+       {Event{Nanos{0}, 0, EventKind::kDialDelta, 0, 0.1}, Event{Nanos{0}, 0, EventKind::kDialDelta, 1, -0.2},
+        Event{Nanos{0}, 0, EventKind::kButton, 2, 1}, Event{Nanos{0}, 0, EventKind::kDialDelta, 7, 0.05}}) {
     ++i;
     enc.encode(e, [&](std::span<const std::uint8_t> r) {
       rec.reports.push_back({std::chrono::milliseconds(100 * i), {r.begin(), r.end()}});
     });
   }
-  auto box = sim::ReplayDialBox::create({"Recorded dial box", "replay", "virtual", 0, 0, "memory.hid", ""}, rec, clock, false);
+  auto box =
+      sim::ReplayDialBox::create({"Recorded dial box", "replay", "virtual", 0, 0, "memory.hid", ""}, rec, clock, false);
   if (!box) {
     reason = box.error().describe();
     return {};
@@ -139,7 +141,8 @@ Made makeSerialPty(const Clock& clock, std::string& reason) {
       }
     }
     *count = static_cast<std::uint16_t>(*count + 5);
-    const std::uint8_t dial[] = {0x32, static_cast<std::uint8_t>(*count >> 8), static_cast<std::uint8_t>(*count & 0xff)};
+    const std::uint8_t dial[] = {0x32, static_cast<std::uint8_t>(*count >> 8),
+                                 static_cast<std::uint8_t>(*count & 0xff)};
     return ::write(fd->get(), dial, sizeof dial) == 3 || errno == EAGAIN || errno == EIO;
   });
   return {std::move(feeder), std::make_unique<SgiDialBox>(slave, clock, 500ms)};
@@ -173,8 +176,9 @@ Made makeHidGadget(const Clock& clock, std::string& reason) {
       reason = "cannot write dial reports to " + *gadget;
       return {};
     }
-    auto feeder = std::make_unique<ThreadFeeder>(
-        [out, report] { return ::write(out->get(), report.data(), report.size()) == static_cast<ssize_t>(report.size()); });
+    auto feeder = std::make_unique<ThreadFeeder>([out, report] {
+      return ::write(out->get(), report.data(), report.size()) == static_cast<ssize_t>(report.size());
+    });
     return {std::move(feeder), std::move(*box)};
   }
   reason = "no hidraw node for " + *ids + " (is usbhid bound to the gadget?)";

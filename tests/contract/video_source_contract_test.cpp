@@ -67,8 +67,8 @@ std::shared_ptr<VideoSource> makeReplay(const Clock& clock, std::string& reason)
     reason = reader.error().describe();
     return nullptr;
   }
-  return std::make_shared<sim::ReplayCamera>(DeviceInfo{"Recorded camera", "replay", "virtual", 0, 0, "camera.bvraw", ""},
-                                             std::move(*reader), clock, true);
+  return std::make_shared<sim::ReplayCamera>(
+      DeviceInfo{"Recorded camera", "replay", "virtual", 0, 0, "camera.bvraw", ""}, std::move(*reader), clock, true);
 }
 
 std::shared_ptr<VideoSource> makeV4l2(const char* variable, const char* what, const Clock& clock, std::string& reason) {
@@ -92,8 +92,9 @@ std::shared_ptr<VideoSource> makeLibcamera(const Clock& clock, std::string& reas
   }
   auto cameras = provider.enumerate();
   if (cameras.empty()) {
-    reason = "libcamera sees no camera here (it needs a CSI sensor or a UVC camera; the virtual lab's UVC gadget "
-             "is tested through v4l2)";
+    reason =
+        "libcamera sees no camera here (it needs a CSI sensor or a UVC camera; the virtual lab's UVC gadget "
+        "is tested through v4l2)";
     return nullptr;
   }
   DeviceRequest r;
@@ -224,21 +225,27 @@ TEST_P(VideoSourceContract, MirrorIsAppliedByTheDeviceOrTheRenderer) {
   EXPECT_FALSE(source_->setControls(c)) << "quality is 0..100";
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Backends, VideoSourceContract,
-    ::testing::Values(
-        VideoBackend{"synthetic", makeSynthetic}, VideoBackend{"replay", makeReplay},
-        VideoBackend{"v4l2_webcam",
-                     [](const Clock& c, std::string& r) { return makeV4l2("BASALT_VLAB_V4L2_WEBCAM", "vivid's webcam input", c, r); },
-                     true},
-        VideoBackend{"v4l2_hdmi",
-                     [](const Clock& c, std::string& r) { return makeV4l2("BASALT_VLAB_V4L2_HDMI", "a vivid HDMI input", c, r); },
-                     true},
-        VideoBackend{"v4l2_uvc",
-                     [](const Clock& c, std::string& r) { return makeV4l2("BASALT_VLAB_V4L2_UVC", "a UVC gadget", c, r); },
-                     true},
-        VideoBackend{"libcamera", makeLibcamera, true}),
-    [](const ::testing::TestParamInfo<VideoBackend>& param) { return param.param.name; });
+INSTANTIATE_TEST_SUITE_P(Backends, VideoSourceContract,
+                         ::testing::Values(VideoBackend{"synthetic", makeSynthetic}, VideoBackend{"replay", makeReplay},
+                                           VideoBackend{"v4l2_webcam",
+                                                        [](const Clock& c, std::string& r) {
+                                                          return makeV4l2("BASALT_VLAB_V4L2_WEBCAM",
+                                                                          "vivid's webcam input", c, r);
+                                                        },
+                                                        true},
+                                           VideoBackend{"v4l2_hdmi",
+                                                        [](const Clock& c, std::string& r) {
+                                                          return makeV4l2("BASALT_VLAB_V4L2_HDMI", "a vivid HDMI input",
+                                                                          c, r);
+                                                        },
+                                                        true},
+                                           VideoBackend{"v4l2_uvc",
+                                                        [](const Clock& c, std::string& r) {
+                                                          return makeV4l2("BASALT_VLAB_V4L2_UVC", "a UVC gadget", c, r);
+                                                        },
+                                                        true},
+                                           VideoBackend{"libcamera", makeLibcamera, true}),
+                         [](const ::testing::TestParamInfo<VideoBackend>& param) { return param.param.name; });
 
 }  // namespace
 }  // namespace basalt::devices

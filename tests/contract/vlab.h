@@ -23,9 +23,7 @@ inline std::optional<std::string> vlabEnv(const char* name) {
 }
 
 /// \brief The reason a real-backend test gives when the lab is not there.
-inline std::string needsVlab(const std::string& what) {
-  return "needs the virtual lab (make vlab): " + what;
-}
+inline std::string needsVlab(const std::string& what) { return "needs the virtual lab (make vlab): " + what; }
 
 /// \brief A report for `descriptor` in which dial `dialIndex` (in the order of the first
 /// relative Dial/Wheel/axis fields) moves by `counts` and everything else is zero. Empty when the

@@ -65,7 +65,8 @@ TEST(BindingsExtended, PerDialOverrideAndNames) {
 TEST(BindingsExtended, AbsoluteDialsMoveByTheirChange) {
   Bindings b = Bindings::lavaDefaults();
   Show show;
-  EXPECT_FALSE(b.apply(dial(1, 0.6, Nanos{0}, EventKind::kDialAbsolute), show)) << "the first reading only sets the origin";
+  EXPECT_FALSE(b.apply(dial(1, 0.6, Nanos{0}, EventKind::kDialAbsolute), show))
+      << "the first reading only sets the origin";
   EXPECT_NEAR(angleY(show), 0, 1e-3);
   ASSERT_TRUE(b.apply(dial(1, 0.85, Nanos{0}, EventKind::kDialAbsolute), show));
   EXPECT_NEAR(angleY(show), 90, 1e-3);
@@ -76,7 +77,7 @@ TEST(BindingsExtended, ShuttleTurnsWhileHeldAndStopsWhenItsDeviceIsLost) {
   b.setShuttleTurnsPerSecond(0.5);
   Show show;
   b.apply(Event{Nanos{0}, 9, EventKind::kShuttle, 1, 0.5}, show);  // ring half right on dial 1 (Y)
-  ASSERT_TRUE(b.advance(std::chrono::milliseconds(500), show));  // 0.5 * 0.5 * 0.5 s = 1/8 turn
+  ASSERT_TRUE(b.advance(std::chrono::milliseconds(500), show));    // 0.5 * 0.5 * 0.5 s = 1/8 turn
   EXPECT_NEAR(angleY(show), 45, 1e-3);
   b.apply(Event{Nanos{0}, 3, EventKind::kDeviceState, 0, 0}, show);  // another device lost: no effect
   EXPECT_TRUE(b.advance(std::chrono::milliseconds(100), show));

@@ -24,7 +24,8 @@ sim::SyntheticProvider::Device dialAt(const std::string& path, std::uint16_t ven
   sim::SyntheticProvider::Device d;
   d.candidate.info = {"Test knob", "synthetic", "virtual", vendor, product, path, ""};
   d.candidate.kind = DeviceKind::kDialBox;
-  for (int i = 0; i < 100; ++i) d.script.push_back({std::chrono::milliseconds(10 * (i + 1)), EventKind::kDialDelta, 0, 0.01});
+  for (int i = 0; i < 100; ++i)
+    d.script.push_back({std::chrono::milliseconds(10 * (i + 1)), EventKind::kDialDelta, 0, 0.01});
   d.loop = true;
   return d;
 }

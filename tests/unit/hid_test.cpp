@@ -49,8 +49,8 @@ void expectPrefixesSafe(const std::vector<std::uint8_t>& bytes) {
   }
 }
 
-#define SKIP_WITHOUT(rec, name)                                                                          \
-  if ((rec).devices.empty()) {                                                                           \
+#define SKIP_WITHOUT(rec, name)                                                                      \
+  if ((rec).devices.empty()) {                                                                       \
     GTEST_SKIP() << "../shared/testdata/hid/udev-hid-bpf/" name " is missing (set BASALT_TESTDATA)"; \
   }
 
@@ -155,9 +155,9 @@ TEST(HidDescriptor, MalformedDescriptorsNameTheByte) {
   };
   const std::vector<Case> cases = {
       {{}, "empty"},
-      {{0x05, 0x01, 0x26, 0xff}, "byte 2"},                    // item cut short
-      {{0xb4}, "Pop without Push"},                            // pop on an empty stack
-      {{0xc0}, "End Collection without"},                      // stray end
+      {{0x05, 0x01, 0x26, 0xff}, "byte 2"},                       // item cut short
+      {{0xb4}, "Pop without Push"},                               // pop on an empty stack
+      {{0xc0}, "End Collection without"},                         // stray end
       {{0x05, 0x01, 0x09, 0x02, 0xa1, 0x01}, "open collection"},  // never closed
       {{0x85, 0x00}, "Report ID 0"},
       {{0x75, 0xff, 0x95, 0x10, 0x81, 0x02}, "Report Size"},  // 255-bit... fine size, but see next
@@ -179,11 +179,10 @@ TEST(HidDescriptor, MalformedDescriptorsNameTheByte) {
 
 TEST(HidDescriptor, FieldsGetOffsetsPerReportIdAndSignedValues) {
   // Report 2: 8-bit signed wheel then 3 buttons; report 3: 16-bit unsigned X.
-  const std::vector<std::uint8_t> desc = {0x05, 0x01, 0x09, 0x02, 0xa1, 0x01, 0x85, 0x02, 0x09, 0x38, 0x15, 0x81,
-                                          0x25, 0x7f, 0x75, 0x08, 0x95, 0x01, 0x81, 0x06, 0x05, 0x09, 0x19, 0x01,
-                                          0x29, 0x03, 0x15, 0x00, 0x25, 0x01, 0x75, 0x01, 0x95, 0x03, 0x81, 0x02,
-                                          0x85, 0x03, 0x05, 0x01, 0x09, 0x30, 0x15, 0x00, 0x26, 0xff, 0xff,
-                                          0x75, 0x10, 0x95, 0x01, 0x81, 0x02, 0xc0};
+  const std::vector<std::uint8_t> desc = {
+      0x05, 0x01, 0x09, 0x02, 0xa1, 0x01, 0x85, 0x02, 0x09, 0x38, 0x15, 0x81, 0x25, 0x7f, 0x75, 0x08, 0x95, 0x01,
+      0x81, 0x06, 0x05, 0x09, 0x19, 0x01, 0x29, 0x03, 0x15, 0x00, 0x25, 0x01, 0x75, 0x01, 0x95, 0x03, 0x81, 0x02,
+      0x85, 0x03, 0x05, 0x01, 0x09, 0x30, 0x15, 0x00, 0x26, 0xff, 0xff, 0x75, 0x10, 0x95, 0x01, 0x81, 0x02, 0xc0};
   auto r = parseReportDescriptor(desc);
   ASSERT_TRUE(r) << r.error().describe();
   ASSERT_EQ(r->fields.size(), 3u);
@@ -247,8 +246,8 @@ TEST(DialProfiles, ShuttleJogWrapsRingAndButtons) {
 
 TEST(DialProfiles, AbsoluteWrappingAxisGivesDeltas) {
   // One 8-bit absolute Dial with the Wrap flag, 0..255.
-  const std::vector<std::uint8_t> desc = {0x05, 0x01, 0x09, 0x08, 0xa1, 0x01, 0x09, 0x37, 0x15, 0x00, 0x26,
-                                          0xff, 0x00, 0x75, 0x08, 0x95, 0x01, 0x81, 0x0a, 0xc0};
+  const std::vector<std::uint8_t> desc = {0x05, 0x01, 0x09, 0x08, 0xa1, 0x01, 0x09, 0x37, 0x15, 0x00,
+                                          0x26, 0xff, 0x00, 0x75, 0x08, 0x95, 0x01, 0x81, 0x0a, 0xc0};
   auto d = DialDecoder::create(0x1234, 0x5678, desc);
   ASSERT_TRUE(d) << d.error().describe();
   EXPECT_DOUBLE_EQ(d->channels()[0].countsPerTurn, 256);
@@ -301,7 +300,8 @@ TEST(HidRecordingFormat, ParsesWritesAndRejectsWithLineNumbers) {
   ASSERT_EQ(d.reports.size(), 2u);
   EXPECT_EQ(d.reports[0].time, Nanos{1'500'000'000});
   EXPECT_EQ(d.reports[1].time, Nanos{2'250'000'000});
-  EXPECT_EQ(sim::HidRecordingWriter::reportLine(Nanos{1'500'000'000}, d.reports[0].bytes), "E: 000001.500000 2 01 fd\n");
+  EXPECT_EQ(sim::HidRecordingWriter::reportLine(Nanos{1'500'000'000}, d.reports[0].bytes),
+            "E: 000001.500000 2 01 fd\n");
   const std::string header = sim::HidRecordingWriter::header(d, false);
   auto again = sim::parseHidRecording(header + "E: 000001.500000 2 01 fd\n", "again");
   ASSERT_TRUE(again);

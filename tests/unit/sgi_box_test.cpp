@@ -48,7 +48,7 @@ TEST(SgiBoxProtocol, DialCountsWrapAndSplitMessagesJoin) {
 
 TEST(SgiBoxProtocol, ButtonBanks) {
   SgiBoxDecoder d;
-  const std::vector<std::pair<std::uint8_t, int>> presses = {{0xd8, 0}, {0xdf, 7}, {0xd0, 8}, {0xd7, 15},
+  const std::vector<std::pair<std::uint8_t, int>> presses = {{0xd8, 0},  {0xdf, 7},  {0xd0, 8},  {0xd7, 15},
                                                              {0xc8, 16}, {0xcf, 23}, {0xc0, 24}, {0xc7, 31}};
   for (const auto& [byte, button] : presses) {
     auto e = feed(d, {byte});

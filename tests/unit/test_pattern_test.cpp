@@ -23,9 +23,9 @@ bool samePixels(const Frame& a, const Frame& b) {
 }
 
 TEST(TestPattern, FastMovingBoxMatchesAFullDrawInEveryFormat) {
-  for (PixelFormat f : {PixelFormat::kRgba8, PixelFormat::kBgra8, PixelFormat::kRgb8, PixelFormat::kGray8,
-                        PixelFormat::kYuyv, PixelFormat::kUyvy, PixelFormat::kNv12, PixelFormat::kNv21,
-                        PixelFormat::kI420, PixelFormat::kYv12}) {
+  for (PixelFormat f :
+       {PixelFormat::kRgba8, PixelFormat::kBgra8, PixelFormat::kRgb8, PixelFormat::kGray8, PixelFormat::kYuyv,
+        PixelFormat::kUyvy, PixelFormat::kNv12, PixelFormat::kNv21, PixelFormat::kI420, PixelFormat::kYv12}) {
     for (auto [w, h] : {std::pair{64u, 36u}, std::pair{37u, 21u}}) {
       auto pool = FramePool::create({f, w, h, 3, 8, true});
       FrameRef background = pool->acquire(), fast = pool->acquire(), full = pool->acquire();

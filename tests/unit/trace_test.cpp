@@ -72,7 +72,8 @@ TEST(Traces, ARecordingReplaysItsEventsAndFramesExactly) {
     for (int i = 0; i < 40; ++i) {
       dial.script.push_back({std::chrono::milliseconds(37 * (i + 1)), EventKind::kDialDelta,
                              static_cast<std::uint16_t>(i % 8), (i % 2 ? -1 : 1) * 0.05 * (i % 5 + 1)});
-      if (i % 10 == 0) dial.script.push_back({std::chrono::milliseconds(37 * (i + 1) + 5), EventKind::kButton, 4, i % 20 ? 0.0 : 1.0});
+      if (i % 10 == 0)
+        dial.script.push_back({std::chrono::milliseconds(37 * (i + 1) + 5), EventKind::kButton, 4, i % 20 ? 0.0 : 1.0});
     }
     dial.loop = false;
     SyntheticProvider::Device camera;
