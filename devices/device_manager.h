@@ -96,7 +96,7 @@ class DeviceProvider {
                                                                              const Clock& clock);
   /// \brief Backends with hotplug signals of their own (libcamera) report through `notify`
   /// (thread-safe; called by DeviceManager::addProvider).
-  virtual void watchHotplug(std::function<void(HotplugEvent)> notify) { (void)notify; }
+  virtual void watchHotplug(const std::function<void(HotplugEvent)>& notify) { (void)notify; }
 };
 
 /// \brief What the status server and `basalt devices` show for one requested device.

@@ -167,9 +167,10 @@ int recordMain(std::span<const std::string_view> args) {
       manualClock.set(start + frameTime(++frame, fps));
       wiring.manager().step(clock.now());
       (*recorder)->drain();
-      (void)(*loop)->dispatch(Nanos{0});
-    } else {
-      (void)(*loop)->dispatch(std::min<Nanos>(step, std::chrono::milliseconds(50)));
+      if (auto r = (*loop)->dispatch(Nanos{0}); !r) break;
+    } else if (auto r = (*loop)->dispatch(std::min<Nanos>(step, std::chrono::milliseconds(50))); !r) {
+      fmt::print(stderr, "basalt: error: the event loop failed: {}\n", r.error().describe());
+      break;
     }
     registerLive();
     if (seconds && clock.now() - start >= fromSeconds(*seconds)) break;

@@ -101,7 +101,7 @@ Result<HidRecording> parseHidRecording(std::string_view text, std::string_view n
   HidRecording rec;
   HidRecordedDevice* current = nullptr;
   int lineNo = 0;
-  auto bad = [&](std::string what) {
+  auto bad = [&](const std::string& what) {
     return fail(Errc::kParse, what + "; is this an hid-recorder file?", fmt::format("{}:{}", name, lineNo));
   };
   auto device = [&]() -> HidRecordedDevice& {

@@ -12,9 +12,9 @@ namespace basalt::sim {
 
 namespace {
 
-std::string optionOr(const devices::DeviceRequest& request, const std::string& key, std::string fallback) {
+std::string optionOr(const devices::DeviceRequest& request, const std::string& key, const std::string& fallback) {
   const auto it = request.options.find(key);
-  return it == request.options.end() ? std::move(fallback) : it->second;
+  return it == request.options.end() ? fallback : it->second;
 }
 
 std::string where(const devices::DeviceRequest& request) { return fmt::format("device '{}'", request.name); }
@@ -89,6 +89,7 @@ Result<void> applyCameraOptions(const devices::DeviceRequest& request, Synthetic
 
 std::vector<ScriptedInput> SyntheticProvider::demoScript() {
   std::vector<ScriptedInput> script;
+  script.reserve(7);
   for (int i = 0; i < 7; ++i) {
     script.push_back({std::chrono::seconds(i + 1), EventKind::kDialDelta, static_cast<std::uint16_t>(i), 0.05});
   }
@@ -135,6 +136,7 @@ void SyntheticProvider::unplug(const std::string& path) {
 std::vector<devices::DeviceCandidate> SyntheticProvider::enumerate() {
   std::lock_guard lock(mutex_);
   std::vector<devices::DeviceCandidate> out;
+  out.reserve(entries_.size());
   for (const auto& e : entries_) out.push_back(e.device.candidate);
   return out;
 }

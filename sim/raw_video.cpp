@@ -41,7 +41,9 @@ Result<std::unique_ptr<RawVideoWriter>> RawVideoWriter::create(const std::filesy
   return std::unique_ptr<RawVideoWriter>(new RawVideoWriter(f, path, mode));
 }
 
-RawVideoWriter::~RawVideoWriter() { (void)finish(); }
+RawVideoWriter::~RawVideoWriter() {
+  if (auto r = finish(); !r) return;  // a destructor cannot report: call finish() to see the error
+}
 
 Result<void> RawVideoWriter::write(const Frame& frame, Nanos pts) {
   if (!file_) return fail(Errc::kIo, "the trace video is closed", path_.string());

@@ -351,7 +351,9 @@ TraceRecorder::TraceRecorder(std::filesystem::path folder, const Clock& clock, O
   writer_ = std::thread([this] { writerLoop(); });
 }
 
-TraceRecorder::~TraceRecorder() { (void)finish(); }
+TraceRecorder::~TraceRecorder() {
+  if (auto r = finish(); !r) return;  // a destructor cannot report: call finish() to see the error
+}
 
 void TraceRecorder::noteError(const Error& e) {
   if (!firstError_) firstError_ = e;

@@ -150,8 +150,9 @@ Result<DialDecoder> DialDecoder::create(std::uint16_t vendor, std::uint16_t prod
       }
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.rank < b.rank; });
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.rank != b.rank ? a.rank < b.rank : a.order < b.order;  // stable: descriptor order within a rank
+  });
   for (const Candidate& c : candidates) {
     if (d.dials_.size() >= kMaxDials) break;
     Channel ch = c.channel;

@@ -12,7 +12,9 @@
 #include <libusb-1.0/libusb.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <mutex>
 #include <thread>
 
@@ -148,7 +150,7 @@ class PowerMateDialBox final : public DialBox {
   Result<void> doSetLight(int index, double level, bool pulse) override {
     if (index != 0) return fail(Errc::kInvalidArgument, "the PowerMate has one light, 0", info().path);
     std::lock_guard lock(controlMutex_);
-    const auto brightness = static_cast<std::uint16_t>(std::clamp(level, 0.0, 1.0) * 255 + 0.5);
+    const auto brightness = static_cast<std::uint16_t>(std::lround(std::clamp(level, 0.0, 1.0) * 255));
     int rc = libusb_control_transfer(handle_.get(), 0x41, 0x01, 0x0001, brightness, nullptr, 0, 1000);
     if (rc >= 0) rc = libusb_control_transfer(handle_.get(), 0x41, 0x01, 0x0003, pulse ? 1 : 0, nullptr, 0, 1000);
     if (rc < 0) return fail(Errc::kIo, fmt::format("cannot set the LED: {}", libusb_strerror(rc)), info().path);

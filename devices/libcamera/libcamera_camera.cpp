@@ -62,11 +62,12 @@ struct LibcameraProvider::State {
   std::mutex mutex;  // guards notify
   std::function<void(HotplugEvent)> notify;
 
-  void added(std::shared_ptr<lc::Camera> camera) {
+  // libcamera's signals pass the camera by value.
+  void added(std::shared_ptr<lc::Camera> camera) {  // NOLINT(performance-unnecessary-value-param)
     std::lock_guard lock(mutex);
     if (notify) notify({HotplugEvent::Action::kAdded, "libcamera", camera->id()});
   }
-  void removed(std::shared_ptr<lc::Camera> camera) {
+  void removed(std::shared_ptr<lc::Camera> camera) {  // NOLINT(performance-unnecessary-value-param)
     std::lock_guard lock(mutex);
     if (notify) notify({HotplugEvent::Action::kRemoved, "libcamera", camera->id()});
   }
@@ -324,9 +325,9 @@ LibcameraProvider::~LibcameraProvider() {
 
 std::string LibcameraProvider::startError() const { return state_->error; }
 
-void LibcameraProvider::watchHotplug(std::function<void(HotplugEvent)> notify) {
+void LibcameraProvider::watchHotplug(const std::function<void(HotplugEvent)>& notify) {
   std::lock_guard lock(state_->mutex);
-  state_->notify = std::move(notify);
+  state_->notify = notify;
 }
 
 std::vector<DeviceCandidate> LibcameraProvider::enumerate() {

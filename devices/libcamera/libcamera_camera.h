@@ -25,7 +25,7 @@ class LibcameraProvider final : public DeviceProvider {
   std::vector<DeviceCandidate> enumerate() override;
   Result<std::shared_ptr<VideoSource>> openVideoSource(const DeviceCandidate& candidate, const DeviceRequest& request,
                                                        const Clock& clock) override;
-  void watchHotplug(std::function<void(HotplugEvent)> notify) override;
+  void watchHotplug(const std::function<void(HotplugEvent)>& notify) override;
   /// \brief Why libcamera could not start, if it could not (then enumerate() is empty).
   [[nodiscard]] std::string startError() const;
 

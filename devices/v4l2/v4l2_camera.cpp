@@ -28,6 +28,7 @@
 #include <atomic>
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <filesystem>
@@ -377,7 +378,7 @@ Result<void> V4l2Camera::negotiate(bool* noSignal) {
   if (xioctl(fd_.get(), VIDIOC_G_PARM, &parm) == 0) {
     if (fps > 0 && (parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME)) {
       parm.parm.capture.timeperframe.numerator = 1000;
-      parm.parm.capture.timeperframe.denominator = static_cast<std::uint32_t>(fps * 1000 + 0.5);
+      parm.parm.capture.timeperframe.denominator = static_cast<std::uint32_t>(std::lround(fps * 1000));
       xioctl(fd_.get(), VIDIOC_S_PARM, &parm);
     }
     const auto& tpf = parm.parm.capture.timeperframe;

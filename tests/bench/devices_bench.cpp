@@ -145,7 +145,7 @@ void dialToShow(benchmark::State& state) {
     });
     bool changed = false;
     while (!changed) {
-      (void)(*loop)->dispatch(Nanos{std::chrono::seconds(1)});
+      if (!(*loop)->dispatch(Nanos{std::chrono::seconds(1)})) break;
       Event e;
       while (events.pop(e)) changed |= bindings.apply(e, show);
     }
@@ -178,7 +178,7 @@ class LatencyProbe final : public kiosk::FrameParticipant {
     return {};
   }
   Result<void> afterDraw(const kiosk::FrameContext&, render::Output& output) override {
-    (void)output.readBack(image_);  // waits for the GPU: the frame is really drawn
+    if (auto r = output.readBack(image_); !r) return r;  // waits for the GPU: the frame is really drawn
     const Nanos now = clock_.now();
     render_.push_back(toSeconds(now - drawStart_));
     if (captured_.count() > 0) latency_.push_back(toSeconds(now - captured_));
@@ -210,7 +210,10 @@ void cameraLatency(benchmark::State& state) {
     r.name = "camera";
     r.kind = devices::DeviceKind::kVideoSource;
     r.options = {{"format", "NV12"}, {"size", "640x360"}, {"fps", "30"}};
-    (void)wiring.manager().request(r);
+    if (!wiring.manager().request(r)) {
+      state.SkipWithError("cannot request the camera");
+      return;
+    }
     wiring.start(false);
     runtime::Show show = runtime::Show::makeDefault();
     auto stream = wiring.manager().videoStream("camera");
@@ -241,7 +244,7 @@ struct ReplayFigures {
 ReplayFigures replayFigures;
 
 std::filesystem::path makeTrace() {
-  const auto dir = std::filesystem::temp_directory_path() / "basalt-bench-replay.trace";
+  auto dir = std::filesystem::temp_directory_path() / "basalt-bench-replay.trace";
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);
   ManualClock clock;
@@ -250,8 +253,10 @@ std::filesystem::path makeTrace() {
   devices::DeviceInfo dialInfo = sim::SyntheticDial::defaultInfo();
   devices::DeviceInfo camInfo = sim::SyntheticCamera::defaultInfo();
   const devices::VideoMode mode{PixelFormat::kNv12, 640, 360, 30};
-  (void)(*recorder)->addDialBox(1, "dials", dialInfo, devices::virtualDialBoxDescriptor());
-  (void)(*recorder)->addVideoSource(2, "camera", camInfo, mode);
+  if (!(*recorder)->addDialBox(1, "dials", dialInfo, devices::virtualDialBoxDescriptor()) ||
+      !(*recorder)->addVideoSource(2, "camera", camInfo, mode)) {
+    return {};
+  }
   devices::VirtualReportEncoder enc;
   auto pool = FramePool::create({mode.format, mode.width, mode.height, 31, 1, true});
   std::vector<FrameRef> lap;  // one second of moving content, drawn once
@@ -264,7 +269,7 @@ std::filesystem::path makeTrace() {
     clock.set(t);
     enc.encode(Event{t, 1, EventKind::kDialDelta, static_cast<std::uint16_t>(i % 7), 0.01},
                [&](std::span<const std::uint8_t> rep) { (*recorder)->onReport(1, t, rep); });
-    FrameRef f = lap[static_cast<std::size_t>(i % 30)];
+    const FrameRef& f = lap[static_cast<std::size_t>(i % 30)];
     f->pts = t;
     f->sequence = static_cast<std::uint64_t>(i);
     (*recorder)->onFrame(2, f);

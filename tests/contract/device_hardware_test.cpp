@@ -162,7 +162,7 @@ TEST(UdevHotplug, MonitorStartsOrSaysWhy) {
     EXPECT_NE(monitor.error().message().find("retry"), std::string::npos) << monitor.error().describe();
     GTEST_SKIP() << "no udev here: " << monitor.error().describe();
   }
-  (*monitor)->start([](HotplugEvent) {});
+  (*monitor)->start([](const HotplugEvent&) {});
   (*monitor)->stop();
   (*monitor)->stop();  // twice is safe
 }
