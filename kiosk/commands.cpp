@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 
 #include "kiosk/check_command.h"
+#include "kiosk/devices_command.h"
+#include "kiosk/record_command.h"
 #include "kiosk/run_command.h"
 #include "runtime/script/reference.h"
 
@@ -16,6 +18,8 @@ namespace {
 constexpr CommandSpec kCommands[] = {
     {"run", "play a show (the default show when none is given)", runUsage, runMain},
     {"check", "find every error in a show's files (LAVA scripts) without running them", checkUsage, checkMain},
+    {"devices", "list dial boxes, cameras and capture cards, and why one cannot be used", devicesUsage, devicesMain},
+    {"record", "record live devices into a trace folder for replay", recordUsage, recordMain},
 };
 
 constexpr std::string_view kVersion = "basalt 0.1.0";

@@ -18,6 +18,9 @@ void FrameLoop::applyInput(Nanos until) {
                       [this](Event e) {
                         if (bindings_) bindings_->apply(e, show_);
                       });
+  // Continuous input (shuttle rings held off-centre) moves the show by the time since the last frame.
+  if (bindings_ && lastInput_.count() >= 0 && until > lastInput_) bindings_->advance(until - lastInput_, show_);
+  lastInput_ = until;
 }
 
 Result<void> FrameLoop::renderFrame(FrameContext& context) {

@@ -94,7 +94,7 @@ class FrameLoop {
   /// \brief Adds a participant (borrowed: it must outlive the loop's run()).
   void addParticipant(FrameParticipant& participant) { participants_.push_back(&participant); }
   /// \brief The queue input events arrive in (owned by the caller).
-  void setEvents(BoundedQueue<Event>* events, const runtime::Bindings* bindings) {
+  void setEvents(BoundedQueue<Event>* events, runtime::Bindings* bindings) {
     events_ = events;
     bindings_ = bindings;
   }
@@ -120,7 +120,8 @@ class FrameLoop {
   FrameHook hook_;
   std::vector<FrameParticipant*> participants_;
   BoundedQueue<Event>* events_ = nullptr;
-  const runtime::Bindings* bindings_ = nullptr;
+  runtime::Bindings* bindings_ = nullptr;  // stateful: dial speeds and shuttles
+  Nanos lastInput_{-1};
   bool stopRequested_ = false;
 };
 

@@ -14,6 +14,7 @@
 #include <fmt/std.h>
 
 #include "kiosk/commands.h"
+#include "kiosk/device_wiring.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/options.h"
 #include "kiosk/script_player.h"
@@ -113,6 +114,9 @@ Options:
   --record PATH      record the rendered output to PATH (.mp4, .mkv, .mov, .avi, .webm)
   --record-codec C   h264, mjpeg, vp8, vp9 or auto (H.264; MJPEG for .avi; VP9 for .webm)
   --record-frames N  stop recording after N frames (LAVA's Rec slider); default: the run
+  --replay PATH      play the devices recorded in a trace folder (basalt record) or an
+                     hid-recorder file as if they were plugged in; dials drive LAVA's dial table
+  --replay-once      play the recording once instead of looping
   -h, --help         this text
 
 Exit status: 0 when the show ran, 1 when it could not start or failed, 2 for usage errors.
@@ -139,7 +143,9 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--audio"},
                               {"--record", true},
                               {"--record-codec", true},
-                              {"--record-frames", true}});
+                              {"--record-frames", true},
+                              {"--replay", true},
+                              {"--replay-once"}});
   if (!parsed) return std::unexpected(parsed.error());
   RunOptions run;
   for (const ParsedOption& o : *parsed) {
@@ -209,6 +215,11 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       auto n = integerOption(o.name, o.value, 1, INT64_MAX);
       if (!n) return std::unexpected(n.error());
       run.recordFrames = *n;
+    } else if (o.name == "--replay") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--replay needs a trace folder or .hid file");
+      run.replay = std::filesystem::path(o.value);
+    } else if (o.name == "--replay-once") {
+      run.replayOnce = true;
     }
   }
   for (const auto& [name, zoom] : run.zooms) {
@@ -334,6 +345,20 @@ int runShow(const RunOptions& options) {
     recorder = std::move(*r);
     frameLoop.addParticipant(*recorder);
   }
+  // Devices: a replayed trace drives the show through LAVA's dial table.
+  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  std::unique_ptr<DeviceWiring> devices;
+  if (options.replay) {
+    runtime::EventLoop* eventLoop = loop->get();
+    devices = std::make_unique<DeviceWiring>(clock, [eventLoop] { eventLoop->wake(); });
+    if (auto r = devices->addReplay(*options.replay, !options.replayOnce); !r) {
+      return failWith(r.error(), "cannot replay");
+    }
+    frameLoop.addParticipant(devices->participant());
+    frameLoop.setEvents(&devices->events(), &bindings);
+    devices->start(manual);
+  }
+
 
   Image snapshot;
   bool snapshotWritten = false;
@@ -346,6 +371,11 @@ int runShow(const RunOptions& options) {
   });
 
   auto stats = frameLoop.run();
+  std::vector<devices::DeviceStatus> deviceStatus;
+  if (devices) {
+    deviceStatus = devices->manager().status();
+    devices->stop();
+  }
   if (!stats) return failWith(stats.error(), "the show stopped");
 
   if (options.saveModel) {
@@ -375,6 +405,12 @@ int runShow(const RunOptions& options) {
     } else {
       fmt::print("basalt: recorded {} frames to {} ({})\n", recorder->frames(), recorder->options().path.string(),
                  recorder->describe());
+    }
+  }
+  if (devices) {
+    for (const devices::DeviceStatus& s : deviceStatus) {
+      fmt::print("basalt: replayed {} '{}' ({})\n", devices::deviceKindName(s.kind), s.name,
+                 s.lastError.empty() ? std::string(devices::deviceStateName(s.state)) : s.lastError);
     }
   }
   std::fflush(stdout);

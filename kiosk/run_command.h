@@ -40,6 +40,8 @@ struct RunOptions {
   std::optional<std::filesystem::path> record;                        ///< --record PATH
   std::string recordCodec = "auto";                                   ///< --record-codec
   std::optional<std::int64_t> recordFrames;                           ///< --record-frames N
+  std::optional<std::filesystem::path> replay;  ///< a trace folder or hid-recorder file to replay
+  bool replayOnce = false;                      ///< play it once instead of looping
 };
 
 /// \brief Parses the arguments after `run`.
