@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "kiosk/check_command.h"
 #include "kiosk/run_command.h"
 
 namespace basalt::kiosk {
@@ -13,6 +14,7 @@ namespace {
 // One line per command; each command lives in its own file.
 constexpr CommandSpec kCommands[] = {
     {"run", "play a show (the default show when none is given)", runUsage, runMain},
+    {"check", "check show files (show.toml) and print every problem", checkUsage, checkMain},
 };
 
 constexpr std::string_view kVersion = "basalt 0.1.0";
