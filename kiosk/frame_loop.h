@@ -98,6 +98,8 @@ class FrameLoop {
 
  private:
   void applyInput(Nanos until);
+  /// Waits, serving the event loop, until the output can take the next frame (paced outputs).
+  Result<void> waitForOutput();
   Result<void> renderFrame(const FrameContext& context);
   [[nodiscard]] bool participantWantsStop() const;
 

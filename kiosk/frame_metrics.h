@@ -1,0 +1,34 @@
+#pragma once
+
+/// \file
+/// \brief Measures every frame on the wall clock (the loop's own work, and present to present)
+/// and publishes the figures to the status board. Added first to the frame loop, so that its
+/// beforeDraw() starts the frame's clock.
+
+#include "kiosk/frame_loop.h"
+#include "kiosk/status_board.h"
+#include "runtime/bounded_queue.h"
+#include "runtime/clock.h"
+#include "runtime/event.h"
+
+namespace basalt::kiosk {
+
+/// \brief Frame timing for the status server and the summary line.
+///
+/// Threading: the frame loop's thread. Allocates nothing per frame.
+class FrameMetrics final : public FrameParticipant {
+ public:
+  FrameMetrics(StatusBoard& board, const BoundedQueue<Event>* events) : board_(board), events_(events) {}
+
+  Result<void> beforeDraw(const FrameContext& frame) override;
+  void afterPresent(const FrameContext& frame) override;
+
+ private:
+  StatusBoard& board_;
+  const BoundedQueue<Event>* events_;
+  SystemClock wall_;
+  Nanos frameStart_{0};
+  Nanos lastPresent_{0};
+};
+
+}  // namespace basalt::kiosk
