@@ -346,6 +346,21 @@ int runShow(const RunOptions& options) {
 
   auto loop = runtime::EventLoop::create(clock);
   if (!loop) return failWith(loop.error(), "cannot start the event loop");
+  // Signals are blocked before any thread starts (the state writer, the status server, the
+  // renderer's), so that every thread inherits the mask and only the loop receives them.
+  FrameLoop* stopTarget = nullptr;
+  ShowDirector* reloadTarget = nullptr;
+  bool stopBeforeLoop = false;
+  auto signals = (*loop)->watchSignals({SIGINT, SIGTERM, SIGHUP}, [&](int signal) {
+    if (signal == SIGHUP) {
+      if (reloadTarget) reloadTarget->requestReload();
+    } else if (stopTarget) {
+      stopTarget->requestStop();
+    } else {
+      stopBeforeLoop = true;
+    }
+  });
+  if (!signals) return failWith(signals.error(), "cannot watch for signals");
 
   render::OutputRequest request;
   request.kind = options.output ? *options.output : toRenderKind(manifest.output.kind);
@@ -405,14 +420,9 @@ int runShow(const RunOptions& options) {
       DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps});
   director.install(std::move(*loaded), clock.now(), resume);
 
-  auto stopOnSignal = (*loop)->watchSignals({SIGINT, SIGTERM, SIGHUP}, [&frameLoop, &director](int signal) {
-    if (signal == SIGHUP) {
-      director.requestReload();
-    } else {
-      frameLoop.requestStop();
-    }
-  });
-  if (!stopOnSignal) return failWith(stopOnSignal.error(), "cannot watch for signals");
+  stopTarget = &frameLoop;
+  reloadTarget = &director;
+  if (stopBeforeLoop) frameLoop.requestStop();
 
   std::unique_ptr<StatusServer> server;
   if (manifest.status.enabled) {
