@@ -64,10 +64,8 @@ Result<ResumePoint> decodeState(std::string_view text, const std::string& showId
   const auto bad = [](std::string_view why) { return fail(Errc::kParse, std::string(why)); };
   const auto sumAt = text.rfind("checksum=");
   if (!text.starts_with(kMagic) || sumAt == std::string_view::npos) return bad("not a Basalt state file");
-  std::uint64_t stored = 0;
-  const std::string_view sumText = text.substr(sumAt + 9, 16);
-  const auto [end, ec] = std::from_chars(sumText.data(), sumText.data() + sumText.size(), stored, 16);
-  if (ec != std::errc{} || end != sumText.data() + sumText.size() || stored != checksum(text.substr(0, sumAt))) {
+  // The checksum line is the last line, and covers everything before it.
+  if (text.substr(sumAt + 9) != fmt::format("{:016x}\n", checksum(text.substr(0, sumAt)))) {
     return bad("its checksum does not match (a torn write or an edit)");
   }
   ResumePoint p;
