@@ -68,8 +68,8 @@ void StatusBoard::recordFrame(std::int64_t frame, double workSeconds, double int
   intervals_[next_] = static_cast<float>(intervalSeconds);
   next_ = (next_ + 1) % kWindow;
   filled_ = std::min(filled_ + 1, kWindow);
-  frames_ = frame + 1;
-  const bool late = frame > 0 && intervalSeconds > 1.5 / nominalFps_;
+  ++frames_;
+  const bool late = frames_ > 1 && intervalSeconds > 1.5 / nominalFps_;
   if (late) {
     ++late_;
     if (frame >= reloadFrame_ && frame <= reloadFrame_ + 2) ++missedAtReload_;

@@ -131,7 +131,8 @@ class StatusBoard {
   StatusBoard& operator=(const StatusBoard&) = delete;
 
   // ---- frame loop ----
-  /// \brief One frame: seconds of work, seconds since the previous present.
+  /// \brief One frame (numbered as the frame loop numbers them, for reload accounting): seconds
+  /// of work, seconds since the previous present.
   void recordFrame(std::int64_t frame, double workSeconds, double intervalSeconds);
   void setInputDropped(std::uint64_t dropped);
   void setNominalFps(double fps);
