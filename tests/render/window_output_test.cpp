@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <thread>
 #include <string>
 
 #include "render/output.h"
@@ -49,12 +50,11 @@ class Xvfb {
       if (!process_->started()) return;
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
       while (display_.empty() && std::chrono::steady_clock::now() < deadline) {
-        const bool alive = process_->waitForOutput("\n", std::chrono::milliseconds(200));
+        // Reads what arrives within 200 ms (the needle never comes).
+        process_->waitForOutput(std::string(1, '\x01'), std::chrono::milliseconds(200));
         display_ = displayNumber(process_->outputSoFar());
-        if (!alive && display_.empty() && ::kill(process_->pid(), 0) != 0) break;
-        if (!alive && display_.empty() && process_->outputSoFar().find("Fatal server error") != std::string::npos) {
-          break;
-        }
+        // A server that lost the race for a display says so and exits: start another.
+        if (display_.empty() && process_->outputSoFar().find("Fatal server error") != std::string::npos) break;
       }
       if (display_.empty()) process_.reset();
     }
