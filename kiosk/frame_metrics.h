@@ -2,7 +2,8 @@
 
 /// \file
 /// \brief Measures every frame on the wall clock (the loop's own work, and present to present)
-/// and publishes the figures to the status board. Added first to the frame loop, so that its
+/// and in the frame loop thread's CPU time (its work without the time other threads took the
+/// CPU from it), and publishes the figures to the status board. Added first to the frame loop, so that its
 /// beforeDraw() starts the frame's clock.
 
 #include "kiosk/frame_loop.h"
@@ -28,6 +29,7 @@ class FrameMetrics final : public FrameParticipant {
   const BoundedQueue<Event>* events_;
   SystemClock wall_;
   Nanos frameStart_{0};
+  Nanos cpuStart_{0};
   Nanos lastPresent_{0};
 };
 

@@ -366,9 +366,19 @@ class Reader {
   }
 
   std::optional<Manifest> read() {
-    const std::size_t errorsBefore = diags_.errorCount();
     std::string text;
     if (!load(text)) return std::nullopt;
+    return readText(text);
+  }
+
+  std::optional<Manifest> readText(std::string_view text) {
+    const std::size_t errorsBefore = diags_.errorCount();
+    if (text.size() > kMaxManifestBytes) {
+      diags_.error(
+          shown_, 0,
+          fmt::format("the manifest is {} bytes; a show.toml is at most {} bytes", text.size(), kMaxManifestBytes));
+      return std::nullopt;
+    }
     toml::parse_result parsed = toml::parse(text, file_.string());
     if (!parsed) {
       const toml::parse_error& e = parsed.error();
@@ -1472,6 +1482,11 @@ class Reader {
 std::optional<Manifest> readManifest(const std::filesystem::path& file, Diagnostics& diagnostics,
                                      const ReadOptions& options) {
   return Reader(file, diagnostics, options).read();
+}
+
+std::optional<Manifest> readManifestText(std::string_view text, const std::filesystem::path& file,
+                                         Diagnostics& diagnostics, const ReadOptions& options) {
+  return Reader(file, diagnostics, options).readText(text);
 }
 
 }  // namespace basalt::kiosk

@@ -314,6 +314,11 @@ struct ReadOptions {
 std::optional<Manifest> readManifest(const std::filesystem::path& file, Diagnostics& diagnostics,
                                      const ReadOptions& options = {});
 
+/// \brief Validates manifest `text` as if read from `file` (paths resolve against its folder).
+/// For fuzzing and for tools that hold the text already.
+std::optional<Manifest> readManifestText(std::string_view text, const std::filesystem::path& file,
+                                         Diagnostics& diagnostics, const ReadOptions& options = {});
+
 /// \brief Parses "90s", "5m", "1h30m", "250ms" or a plain number of seconds.
 [[nodiscard]] Result<Nanos> parseDuration(std::string_view text);
 /// \brief Parses "09:00-17:30" (24:00 allowed as an end).

@@ -13,7 +13,6 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
-#include "kiosk/check_command.h"
 #include "kiosk/commands.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/frame_metrics.h"
@@ -268,12 +267,12 @@ render::OutputKind toRenderKind(OutputKind kind) {
   return render::OutputKind::kAuto;
 }
 
-/// Reads the manifest as `basalt check` does; prints its errors and warnings.
+/// Reads and validates the manifest (the files it names must exist inside the show folder; their
+/// contents are read as the show loads them, and `basalt check` parses them all beforehand);
+/// prints its errors and warnings.
 std::optional<Manifest> readShowManifest(const std::filesystem::path& file) {
   Diagnostics diagnostics;
-  ReadOptions options;
-  options.fileCheckers = &fileCheckers();
-  auto manifest = readManifest(file, diagnostics, options);
+  auto manifest = readManifest(file, diagnostics);
   for (const Diagnostic& d : diagnostics.items()) {
     if (d.severity != Severity::kNote) fmt::print(stderr, "{}\n", d.format());
   }
@@ -411,7 +410,8 @@ int runShow(const RunOptions& options) {
     }
   }
 
-  auto loaded = loadShow(manifest, clock);
+  // Texture images are read in the background: the first frame does not wait for them.
+  auto loaded = loadShow(manifest, clock, false);
   if (!loaded) return failWith(loaded.error(), "cannot load the show");
 
   runtime::Show show;
@@ -470,8 +470,11 @@ int runShow(const RunOptions& options) {
   fmt::print("basalt: first frame after {:.1f} ms\n", stats->firstFrameSeconds * 1000);
   if (director.reloadsApplied() + director.reloadsFailed() > 0) {
     const FrameFigures f = board.frameFigures();
-    fmt::print("basalt: reloads: {} applied, {} failed; frames missed at a reload: {}\n", director.reloadsApplied(),
-               director.reloadsFailed(), f.missedAtReload);
+    fmt::print(
+        "basalt: reloads: {} applied, {} failed; frames missed at a reload: {} (longest frame at a reload "
+        "{:.1f} ms, median frame {:.1f} ms)\n",
+        director.reloadsApplied(), director.reloadsFailed(), f.missedAtReload, f.longestAtReload * 1e3,
+        f.intervalP50 * 1e3);
   }
   if (const KioskPolicy* policy = director.policy(); policy && options.manifest) {
     fmt::print("basalt: at the end: {}\n", policy->describe());

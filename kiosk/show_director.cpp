@@ -22,6 +22,7 @@ ShowDirector::ShowDirector(DirectorContext context) : context_(context) {}
 
 ShowDirector::~ShowDirector() {
   if (loader_.joinable()) loader_.join();
+  if (textureLoader_.joinable()) textureLoader_.join();
   if (show_) {
     for (DeviceSlot& slot : show_->devices) {
       if (slot.dialBox) slot.dialBox->close();
@@ -70,6 +71,10 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
     }
     t.live = false;
   }
+  ++showGeneration_;
+  // Images not read yet (start-up) are read once the first frame is on screen, so that decoding
+  // them never delays it.
+  texturesPending_ = true;
   policy_ = std::make_unique<KioskPolicy>(show_->manifest, show_->schedule);
   policy_->start(now, wall, resume);
   appliedGeneration_ = 0;
@@ -77,6 +82,49 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   publishDevices();
   publishStreams();
   old.reset();  // after the new show is on: its players and devices go now
+}
+
+void ShowDirector::loadTexturesInBackground() {
+  std::vector<std::pair<std::string, std::filesystem::path>> wanted;
+  for (const LoadedTexture& t : show_->textures) {
+    if (!t.image && !t.imageFile.empty()) wanted.emplace_back(t.name, t.imageFile);
+  }
+  if (wanted.empty()) return;
+  if (textureLoader_.joinable()) textureLoader_.join();
+  textureLoader_ = std::thread([this, wanted = std::move(wanted), generation = showGeneration_] {
+    std::vector<std::pair<std::string, std::optional<Image>>> images;
+    for (const auto& [name, file] : wanted) images.emplace_back(name, readTextureImage(name, file));
+    {
+      std::lock_guard lock(reloadMutex_);
+      textures_ = std::move(images);
+      texturesFor_ = generation;
+      texturesReady_ = true;
+    }
+    context_.loop.wake();
+  });
+}
+
+void ShowDirector::pollTextures() {
+  std::vector<std::pair<std::string, std::optional<Image>>> images;
+  {
+    std::lock_guard lock(reloadMutex_);
+    if (!texturesReady_) return;
+    texturesReady_ = false;
+    if (texturesFor_ != showGeneration_) return;  // read for a show that has been replaced since
+    images = std::move(textures_);
+  }
+  for (auto& [name, image] : images) {
+    if (!image) continue;
+    for (LoadedTexture& t : show_->textures) {
+      if (t.name != name) continue;
+      t.image = std::move(*image);
+      if (!t.live) {
+        if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
+          log::warn(kLogDirector, "texture '{}': {}", t.name, r.error().describe());
+        }
+      }
+    }
+  }
 }
 
 void ShowDirector::requestReload() {
@@ -349,6 +397,7 @@ void ShowDirector::saveState(Nanos now) {
 
 Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
   pollReload(frame);
+  pollTextures();
   handleControls(frame);
   const Nanos now = frame.time;
   serviceDevices(now);
@@ -384,7 +433,12 @@ Result<void> ShowDirector::afterDraw(const FrameContext& /*frame*/, render::Outp
   return {};
 }
 
-void ShowDirector::afterPresent(const FrameContext& /*frame*/) {}
+void ShowDirector::afterPresent(const FrameContext& /*frame*/) {
+  if (texturesPending_) {
+    texturesPending_ = false;
+    loadTexturesInBackground();
+  }
+}
 
 void ShowDirector::publishShow() {
   const Programme& p = policy_->current();

@@ -76,6 +76,8 @@ class ShowDirector final : public FrameParticipant {
  private:
   void takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume);
   void pollReload(const FrameContext& frame);
+  void loadTexturesInBackground();
+  void pollTextures();
   void handleControls(const FrameContext& frame);
   void serviceDevices(Nanos now);
   void applyInput(Nanos until);
@@ -103,6 +105,13 @@ class ShowDirector final : public FrameParticipant {
   bool reloadReady_ = false;              // guarded by reloadMutex_
   std::unique_ptr<LoadedShow> reloaded_;  // guarded by reloadMutex_
   std::string reloadError_;               // guarded by reloadMutex_
+  // Texture images read in the background after start-up, handed over the same way.
+  std::thread textureLoader_;
+  std::uint64_t showGeneration_ = 0;                                    // frame loop only
+  bool texturesPending_ = false;                                        // frame loop only
+  bool texturesReady_ = false;                                          // guarded by reloadMutex_
+  std::uint64_t texturesFor_ = 0;                                       // guarded by reloadMutex_
+  std::vector<std::pair<std::string, std::optional<Image>>> textures_;  // guarded by reloadMutex_
   std::int64_t reloadsApplied_ = 0;
   std::int64_t reloadsFailed_ = 0;
   std::int64_t lastReloadFrame_ = -1;

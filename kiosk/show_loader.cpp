@@ -60,7 +60,16 @@ void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory) {
 
 std::string entryKey(const EntrySpec& entry) { return entry.path.empty() ? entry.text : entry.path.string(); }
 
-Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock) {
+std::optional<Image> readTextureImage(const std::string& texture, const std::filesystem::path& file) {
+  auto image = media::readImage(file);
+  if (!image) {
+    log::warn(kLogLoader, "texture '{}': cannot read {}: {}", texture, file, image.error().message());
+    return std::nullopt;
+  }
+  return std::move(*image);
+}
+
+Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock, bool readImages) {
   auto show = std::make_unique<LoadedShow>();
   show->manifest = std::move(manifest);
   const Manifest& m = show->manifest;
@@ -121,18 +130,10 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
     LoadedTexture t;
     t.name = spec.name;
     t.source = spec.source;
-    const auto readImage = [&](const std::filesystem::path& file) -> std::optional<Image> {
-      auto image = media::readImage(file);
-      if (!image) {
-        log::warn(kLogLoader, "texture '{}': cannot read {}: {}", spec.name, file, image.error().message());
-        return std::nullopt;
-      }
-      return std::move(*image);
-    };
-    if (!spec.file.empty()) t.image = readImage(spec.file);
+    if (!spec.file.empty()) t.imageFile = spec.file;
     if (const MediaSpec* media = m.findMedia(spec.source)) {
       if (media->kind == MediaKind::kImage) {
-        t.image = readImage(media->file);
+        t.imageFile = media->file;
       } else {
         StreamFactory factory;
         {
@@ -150,9 +151,10 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
           t.streamState =
               media->kind == MediaKind::kMovie ? "this build has no movie player" : "this build has no camera stream";
         }
-        if (!spec.fallback.empty()) t.image = readImage(spec.fallback);
+        t.imageFile = spec.fallback;
       }
     }
+    if (readImages && !t.imageFile.empty()) t.image = readTextureImage(t.name, t.imageFile);
     show->textures.push_back(std::move(t));
   }
   return show;
@@ -167,7 +169,7 @@ Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path&
     return fail(Errc::kParse, fmt::format("{} has {} problem{}", file.string(), diagnostics.errorCount(),
                                           diagnostics.errorCount() == 1 ? "" : "s"));
   }
-  return loadShow(std::move(*manifest), clock);
+  return loadShow(std::move(*manifest), clock, true);
 }
 
 }  // namespace basalt::kiosk

@@ -75,7 +75,8 @@ struct DeviceSlot {
 struct LoadedTexture {
   std::string name;
   std::string source;                     ///< the media it shows, "" for a plain image
-  std::optional<Image> image;             ///< the image file, or the fallback for a stream
+  std::filesystem::path imageFile;        ///< the image to show, or the fallback for a stream
+  std::optional<Image> image;             ///< imageFile, once read
   std::unique_ptr<TextureStream> stream;  ///< movies and cameras
   std::string streamState;                ///< why there is no stream, when there is none
   bool live = false;                      ///< kept by the director
@@ -96,7 +97,13 @@ std::string entryKey(const EntrySpec& entry);
 
 /// \brief Prepares a validated manifest. Errors only for what makes the show impossible (a time
 /// zone that vanished); unplayable items, devices and streams are recorded and reported.
-[[nodiscard]] Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock);
+/// Without `readImages` texture images are left for the director to read in the background
+/// (start-up: the first frame does not wait for image decoding).
+[[nodiscard]] Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock,
+                                                           bool readImages = true);
+
+/// \brief Reads a texture's image, or says why not (a warning) and returns nothing.
+std::optional<Image> readTextureImage(const std::string& texture, const std::filesystem::path& file);
 
 /// \brief Reads, validates and loads `file`: what a reload does on its own thread.
 [[nodiscard]] Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path& file, const Clock& clock,

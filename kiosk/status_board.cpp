@@ -62,23 +62,23 @@ StatusBoard::~StatusBoard() {
   log::removeSink(counter_);
 }
 
-void StatusBoard::recordFrame(std::int64_t frame, double workSeconds, double intervalSeconds) {
+void StatusBoard::recordFrame(std::int64_t frame, double workSeconds, double intervalSeconds, double cpuSeconds,
+                              std::uint64_t inputDropped) {
   std::lock_guard lock(mutex_);
+  inputDropped_ = inputDropped;
   work_[next_] = static_cast<float>(workSeconds);
+  cpu_[next_] = static_cast<float>(cpuSeconds);
   intervals_[next_] = static_cast<float>(intervalSeconds);
   next_ = (next_ + 1) % kWindow;
   filled_ = std::min(filled_ + 1, kWindow);
   ++frames_;
   const bool late = frames_ > 1 && intervalSeconds > 1.5 / nominalFps_;
+  const bool atReload = frame >= reloadFrame_ && frame <= reloadFrame_ + 2;
+  if (atReload) longestAtReload_ = std::max(longestAtReload_, intervalSeconds);
   if (late) {
     ++late_;
-    if (frame >= reloadFrame_ && frame <= reloadFrame_ + 2) ++missedAtReload_;
+    if (atReload) ++missedAtReload_;
   }
-}
-
-void StatusBoard::setInputDropped(std::uint64_t dropped) {
-  std::lock_guard lock(mutex_);
-  inputDropped_ = dropped;
 }
 
 void StatusBoard::setNominalFps(double fps) {
@@ -139,23 +139,30 @@ void percentiles(std::vector<float>& values, double& p50, double& p90, double& p
 FrameFigures StatusBoard::frameFigures() const {
   std::vector<float> intervals;
   std::vector<float> work;
+  double cpuSum = 0;
   FrameFigures f;
   {
     std::lock_guard lock(mutex_);
     f.frames = frames_;
     f.lateFrames = late_;
     f.missedAtReload = missedAtReload_;
+    f.longestAtReload = longestAtReload_;
     f.inputDropped = inputDropped_;
     f.window = filled_;
     intervals.assign(intervals_.begin(), intervals_.begin() + static_cast<std::ptrdiff_t>(filled_));
     work.assign(work_.begin(), work_.begin() + static_cast<std::ptrdiff_t>(filled_));
+    for (std::size_t i = 0; i < filled_; ++i) cpuSum += static_cast<double>(cpu_[i]);
   }
+  f.cpuMean = filled_ > 0 ? cpuSum / static_cast<double>(filled_) : 0;
   // The first frame's interval is its start-up time: not a frame interval.
   if (f.frames <= static_cast<std::int64_t>(kWindow) && !intervals.empty()) intervals.erase(intervals.begin());
   double sum = 0;
   for (const float v : intervals) sum += static_cast<double>(v);
   f.framesPerSecond = sum > 0 ? static_cast<double>(intervals.size()) / sum : 0;
   percentiles(intervals, f.intervalP50, f.intervalP90, f.intervalP99, f.intervalMax);
+  double workSum = 0;
+  for (const float v : work) workSum += static_cast<double>(v);
+  f.workMean = work.empty() ? 0 : workSum / static_cast<double>(work.size());
   percentiles(work, f.workP50, f.workP90, f.workP99, f.workMax);
   return f;
 }

@@ -65,7 +65,10 @@ struct FrameFigures {
   double framesPerSecond = 0;       ///< over the recent window
   double intervalP50 = 0, intervalP90 = 0, intervalP99 = 0, intervalMax = 0;  ///< seconds, present to present
   double workP50 = 0, workP90 = 0, workP99 = 0, workMax = 0;  ///< seconds of the loop's own work per frame
-  std::size_t window = 0;                                     ///< frames the percentiles are over
+  double workMean = 0;                                        ///< seconds, over the window
+  double cpuMean = 0;          ///< seconds of the loop thread's CPU time per frame, over the window
+  double longestAtReload = 0;  ///< seconds: the longest present-to-present in the frames after a reload
+  std::size_t window = 0;      ///< frames the percentiles are over
 };
 
 /// \brief Everything the server reports, copied at one moment.
@@ -133,8 +136,8 @@ class StatusBoard {
   // ---- frame loop ----
   /// \brief One frame (numbered as the frame loop numbers them, for reload accounting): seconds
   /// of work, seconds since the previous present.
-  void recordFrame(std::int64_t frame, double workSeconds, double intervalSeconds);
-  void setInputDropped(std::uint64_t dropped);
+  void recordFrame(std::int64_t frame, double workSeconds, double intervalSeconds, double cpuSeconds = 0,
+                   std::uint64_t inputDropped = 0);
   void setNominalFps(double fps);
   /// \brief The frame in which a reloaded show took over.
   void noteReloadApplied(std::int64_t frame);
@@ -161,12 +164,14 @@ class StatusBoard {
   double nominalFps_;                       // guarded by mutex_
   std::array<float, kWindow> intervals_{};  // seconds; guarded by mutex_
   std::array<float, kWindow> work_{};       // seconds; guarded by mutex_
+  std::array<float, kWindow> cpu_{};        // seconds; guarded by mutex_
   std::size_t next_ = 0;                    // guarded by mutex_
   std::size_t filled_ = 0;                  // guarded by mutex_
   std::int64_t frames_ = 0;                 // guarded by mutex_
   std::int64_t late_ = 0;                   // guarded by mutex_
   std::int64_t reloadFrame_ = -100;         // guarded by mutex_
   std::int64_t missedAtReload_ = 0;         // guarded by mutex_
+  double longestAtReload_ = 0;              // guarded by mutex_
   std::uint64_t inputDropped_ = 0;          // guarded by mutex_
   ShowStatus show_;                         // guarded by mutex_
   std::vector<DeviceStatus> devices_;       // guarded by mutex_

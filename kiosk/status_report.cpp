@@ -178,7 +178,15 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
   for (const auto& [q, v] : {std::pair{"0.5", f.workP50}, {"0.9", f.workP90}, {"0.99", f.workP99}}) {
     out += fmt::format("basalt_frame_work_seconds{{quantile=\"{}\"}} {:.6f}\n", q, v);
   }
+  out += fmt::format("basalt_frame_work_seconds_sum {:.6f}\n", f.workMean * static_cast<double>(f.window));
   out += fmt::format("basalt_frame_work_seconds_count {}\n", f.window);
+  metric("basalt_frame_work_cpu_seconds", "summary",
+         "The frame loop thread's CPU time per frame (its work without preemption), recent frames.");
+  out += fmt::format("basalt_frame_work_cpu_seconds_sum {:.6f}\n", f.cpuMean * static_cast<double>(f.window));
+  out += fmt::format("basalt_frame_work_cpu_seconds_count {}\n", f.window);
+  metric("basalt_frame_interval_at_reload_max_seconds", "gauge",
+         "The longest present-to-present in the three frames after a reload took over.");
+  out += fmt::format("basalt_frame_interval_at_reload_max_seconds {:.6f}\n", f.longestAtReload);
   metric("basalt_input_events_dropped_total", "counter", "Input events lost to a full queue.");
   out += fmt::format("basalt_input_events_dropped_total {}\n", f.inputDropped);
   metric("basalt_kiosk_open", "gauge", "1 within opening hours.");

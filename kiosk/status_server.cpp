@@ -4,6 +4,8 @@
 #include "kiosk/status_server.h"
 
 #include <httplib.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <charconv>
 #include <fstream>
@@ -45,6 +47,15 @@ void replyJson(httplib::Response& res, int status, bool ok, std::string_view mes
   res.set_content(fmt::format("{{\"ok\": {}, \"status\": {}, \"message\": {}}}\n", ok ? "true" : "false", status,
                               jsonString(message)),
                   "application/json");
+}
+
+/// The server's threads run at a lower priority than the frame loop (nice 10), so that answering
+/// requests takes CPU time from the show only when there is some to spare.
+void yieldToTheShow() {
+  thread_local bool done = false;
+  if (done) return;
+  done = true;
+  ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
 }
 
 }  // namespace
@@ -138,7 +149,10 @@ Result<std::unique_ptr<StatusServer>> StatusServer::start(const StatusSpec& spec
                                                 spec.host, spec.port, std::strerror(errno)));
   }
   server->port_ = static_cast<std::uint16_t>(port);
-  server->thread_ = std::thread([s = server.get()] { s->server_->listen_after_bind(); });
+  server->thread_ = std::thread([s = server.get()] {
+    yieldToTheShow();
+    s->server_->listen_after_bind();
+  });
   log::info(kLogStatus, "status server on {} (controls {})", server->url(),
             server->controlsEnabled() ? "on, with the token" : "off: no token");
   return server;
@@ -147,6 +161,7 @@ Result<std::unique_ptr<StatusServer>> StatusServer::start(const StatusSpec& spec
 void StatusServer::routes() {
   httplib::Server& http = *server_;
   http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    yieldToTheShow();
     requests_.fetch_add(1, std::memory_order_relaxed);
     if (!limiter_->allow(req.remote_addr)) {
       rejectedRate_.fetch_add(1, std::memory_order_relaxed);

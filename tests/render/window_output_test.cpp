@@ -11,8 +11,8 @@
 #include <unistd.h>
 
 #include <cstdlib>
-#include <thread>
 #include <string>
+#include <thread>
 
 #include "render/output.h"
 #include "render/renderer.h"
