@@ -18,7 +18,7 @@ constexpr Nanos kMaxRetry = std::chrono::seconds(30);
 
 }  // namespace
 
-ShowDirector::ShowDirector(DirectorContext context) : context_(context) {}
+ShowDirector::ShowDirector(DirectorContext context) : context_(context) { context_.board.setShowClock(context_.clock); }
 
 ShowDirector::~ShowDirector() {
   if (loader_.joinable()) loader_.join();
@@ -76,6 +76,7 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   // them never delays it.
   texturesPending_ = true;
   policy_ = std::make_unique<KioskPolicy>(show_->manifest, show_->schedule);
+  scheduleForStatus_ = show_->schedule ? std::make_shared<const Schedule>(*show_->schedule) : nullptr;
   policy_->start(now, wall, resume);
   appliedGeneration_ = 0;
   applyProgramme(now);
@@ -453,7 +454,7 @@ void ShowDirector::publishShow() {
   s.index = p.item ? p.index + 1 : 0;
   s.count = p.count;
   s.description = policy_->describe();
-  if (policy_->schedule()) s.nextScheduleChange = policy_->schedule()->nextChange(context_.clock.wallNow());
+  s.schedule = scheduleForStatus_;
   context_.board.publishShow(std::move(s));
 }
 

@@ -91,6 +91,7 @@ class ShowDirector final : public FrameParticipant {
   DirectorContext context_;
   std::unique_ptr<LoadedShow> show_;
   std::unique_ptr<KioskPolicy> policy_;
+  std::shared_ptr<const Schedule> scheduleForStatus_;
   ItemPlayer* player_ = nullptr;  // the playing item's player, owned by show_
   std::uint64_t appliedGeneration_ = 0;
   bool displayOn_ = true;

@@ -181,6 +181,8 @@ StatusSnapshot StatusBoard::snapshot(WallTime now) const {
     s.reloadFailures = reloadFailures_;
     s.lastReload = lastReload_;
   }
+  if (s.show.schedule)
+    s.show.nextScheduleChange = s.show.schedule->nextChange(showClock_ ? showClock_->wallNow() : now);
   s.logTail = ring_->snapshot(log::Level::kInfo);
   s.lastErrors = ring_->snapshot(log::Level::kWarn);
   if (s.lastErrors.size() > 20) s.lastErrors.erase(s.lastErrors.begin(), s.lastErrors.end() - 20);

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "kiosk/schedule.h"
 #include "runtime/bounded_queue.h"
 #include "runtime/clock.h"
 #include "runtime/image.h"
@@ -52,8 +53,11 @@ struct ShowStatus {
   std::string item;       ///< the item's name, "" when none
   std::size_t index = 0;  ///< 1-based place in its list, 0 when none
   std::size_t count = 0;
-  std::string description;  ///< KioskPolicy::describe()
-  std::optional<WallTime> nextScheduleChange;
+  std::string description;                     ///< KioskPolicy::describe()
+  std::optional<WallTime> nextScheduleChange;  ///< filled by StatusBoard::snapshot()
+  /// The show's opening hours (immutable, shared), so that the server works out the next change
+  /// on its own thread rather than the frame loop's.
+  std::shared_ptr<const Schedule> schedule;
 };
 
 /// \brief Figures derived from the recent frames.
@@ -151,6 +155,8 @@ class StatusBoard {
   [[nodiscard]] FrameFigures frameFigures() const;
   BoundedQueue<ControlRequest>& controls() { return controls_; }
   BoundedQueue<std::shared_ptr<SnapshotRequest>>& snapshotRequests() { return snapshots_; }
+  /// \brief The show's Clock, whose calendar time the schedule is read in (any thread reads it).
+  void setShowClock(const Clock& clock) { showClock_ = &clock; }
   /// \brief Set by the run to wake the frame loop when a request arrives.
   void setWake(std::function<void()> wake);
   void wake() const;
@@ -180,6 +186,7 @@ class StatusBoard {
   std::int64_t reloadFailures_ = 0;         // guarded by mutex_
   std::string lastReload_;                  // guarded by mutex_
   std::function<void()> wake_;              // set before the server starts
+  const Clock* showClock_ = nullptr;        // set before the server starts
   std::shared_ptr<log::RingSink> ring_;
   std::shared_ptr<CountingSink> counter_;
   BoundedQueue<ControlRequest> controls_{16};

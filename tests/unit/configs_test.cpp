@@ -31,8 +31,8 @@ TEST(SystemdUnit, HasWhatAKioskServiceNeeds) {
   for (const char* line : {"Type=notify", "WatchdogSec=10", "Restart=always", "NoNewPrivileges=yes",
                            "ProtectSystem=strict", "ProtectHome=yes", "PrivateTmp=yes", "DevicePolicy=closed",
                            "DeviceAllow=char-drm rw", "DeviceAllow=char-video4linux rw", "DeviceAllow=char-hidraw rw",
-                           "DeviceAllow=char-usb_device rw", "StateDirectory=basalt", "ExecReload=/bin/kill -HUP $MAINPID",
-                           "StartLimitIntervalSec=0", "CapabilityBoundingSet="}) {
+                           "DeviceAllow=char-usb_device rw", "StateDirectory=basalt",
+                           "ExecReload=/bin/kill -HUP $MAINPID", "StartLimitIntervalSec=0", "CapabilityBoundingSet="}) {
     EXPECT_NE(unit.find(std::string("\n") + line + "\n"), std::string::npos) << line;
   }
   EXPECT_EQ(unit.find("MemoryDenyWriteExecute=yes"), std::string::npos)
@@ -52,7 +52,8 @@ TEST(SystemdUnit, SystemdAcceptsEveryLine) {
   const auto security =
       test::run({"/usr/bin/systemd-analyze", "security", "--offline=true", (dir / "basalt.service").string()});
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(security.output, m, std::regex(R"(Overall exposure level for basalt\.service: ([0-9.]+))")))
+  ASSERT_TRUE(
+      std::regex_search(security.output, m, std::regex(R"(Overall exposure level for basalt\.service: ([0-9.]+))")))
       << security.output;
   EXPECT_LT(std::stod(m[1]), 5.0) << "systemd rates the sandbox: " << m[0];
 }
@@ -60,7 +61,8 @@ TEST(SystemdUnit, SystemdAcceptsEveryLine) {
 TEST(UdevRule, EveryLineParsesAndTheSupportedDevicesAreCovered) {
   const std::string rules = read(test::sourceDir() / "configs/udev/70-basalt.rules");
   // KEY or KEY{attr}, an operator, a quoted value; pairs separated by commas.
-  const std::regex pair(R"re(\s*(ACTION|SUBSYSTEM|KERNEL|KERNELS|DRIVERS|ENV\{[A-Z_]+\}|ATTR\{[a-zA-Z_]+\}|ATTRS\{[a-zA-Z_]+\}|GROUP|MODE|TAG|GOTO|LABEL)(==|!=|\+=|=)"[^"]*"\s*)re");
+  const std::regex pair(
+      R"re(\s*(ACTION|SUBSYSTEM|KERNEL|KERNELS|DRIVERS|ENV\{[A-Z_]+\}|ATTR\{[a-zA-Z_]+\}|ATTRS\{[a-zA-Z_]+\}|GROUP|MODE|TAG|GOTO|LABEL)(==|!=|\+=|=)"[^"]*"\s*)re");
   std::istringstream in(rules);
   std::string line;
   int number = 0;
