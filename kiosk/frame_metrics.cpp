@@ -2,7 +2,11 @@
 
 #include <time.h>
 
+#include "runtime/log.h"
+
 namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Metrics, "kiosk");
 
 namespace {
 
@@ -28,6 +32,7 @@ void FrameMetrics::afterPresent(const FrameContext& frame) {
   const double interval = lastPresent_ == Nanos{0} ? work : toSeconds(now - lastPresent_);
   lastPresent_ = now;
   board_.recordFrame(frame.frame, work, interval, cpu, events_ ? events_->dropped() : 0);
+  if (frame.frame == 0 && !output_.empty()) log::info(kLogMetrics, "first frame on {}", output_);
 }
 
 }  // namespace basalt::kiosk

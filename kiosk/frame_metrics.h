@@ -6,6 +6,8 @@
 /// CPU from it), and publishes the figures to the status board. Added first to the frame loop, so that its
 /// beforeDraw() starts the frame's clock.
 
+#include <string>
+
 #include "kiosk/frame_loop.h"
 #include "kiosk/status_board.h"
 #include "runtime/bounded_queue.h"
@@ -19,7 +21,9 @@ namespace basalt::kiosk {
 /// Threading: the frame loop's thread. Allocates nothing per frame.
 class FrameMetrics final : public FrameParticipant {
  public:
-  FrameMetrics(StatusBoard& board, const BoundedQueue<Event>* events) : board_(board), events_(events) {}
+  /// \brief `output` names where frames go, for the line logged when the first one is presented.
+  FrameMetrics(StatusBoard& board, const BoundedQueue<Event>* events, std::string output = {})
+      : board_(board), events_(events), output_(std::move(output)) {}
 
   Result<void> beforeDraw(const FrameContext& frame) override;
   void afterPresent(const FrameContext& frame) override;
@@ -27,6 +31,7 @@ class FrameMetrics final : public FrameParticipant {
  private:
   StatusBoard& board_;
   const BoundedQueue<Event>* events_;
+  std::string output_;
   SystemClock wall_;
   Nanos frameStart_{0};
   Nanos cpuStart_{0};

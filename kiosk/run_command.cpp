@@ -437,19 +437,14 @@ int runShow(const RunOptions& options) {
     }
   }
 
-  FrameMetrics metrics(board, &events);
+  FrameMetrics metrics(board, &events, (*output)->describe());
   frameLoop.addParticipant(metrics);
   frameLoop.addParticipant(director);
   frameLoop.addParticipant(*supervisor);
 
   Image snapshot;
   bool snapshotWritten = false;
-  bool firstShown = false;
   frameLoop.setFrameHook([&](std::int64_t, bool last, render::Output& out) -> Result<void> {
-    if (!firstShown) {
-      firstShown = true;
-      log::info(kLogRun, "first frame on {}", out.describe());
-    }
     if (!last || out.kind() != "headless") return {};
     if (auto r = out.readBack(snapshot); !r) return r;
     if (auto r = media::writeImage(snapshotPath, snapshot); !r) return r;

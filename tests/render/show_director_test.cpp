@@ -239,7 +239,7 @@ items = [ { entry = "default", name = "attract" } ]
   EXPECT_EQ(h.item(), "one") << "a visitor's touch starts the playlist";
   h.run(18);  // 1.2 s: the button was pressed at 1 s
   EXPECT_EQ(h.item(), "two");
-  h.run(30 * 6);  // 7.2 s: five seconds after the last touch
+  h.run(std::int64_t{30} * 6);  // 7.2 s: five seconds after the last touch
   EXPECT_EQ(h.item(), "attract");
   EXPECT_EQ(h.recorder().blackFrames(), 0u);
 }
@@ -287,7 +287,7 @@ duration = "10s"
 
 TEST(ShowDirector, OutsideOpeningHoursTheDisplayGoesDark) {
   // Monday 2026-03-23 12:00 UTC; the show opens on Tuesdays only.
-  const WallTime monday{std::chrono::seconds(daysFromCivil(2026, 3, 23) * 86400 + 12 * 3600)};
+  const WallTime monday{std::chrono::seconds(daysFromCivil(2026, 3, 23) * 86400 + std::int64_t{12} * 3600)};
   Harness h("closed", monday);
   OPEN_OR_SKIP(h);
   ASSERT_TRUE(h.install(R"(

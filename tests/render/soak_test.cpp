@@ -216,9 +216,9 @@ requests_per_second = 1000
   // 256 KiB over 14 hours is 6 bytes a frame: a per-frame leak of any size fails this.
   const std::size_t baseline = rss[9];
   const std::size_t highest = *std::max_element(rss.begin() + 9, rss.end());
-  EXPECT_LE(rss.back(), baseline + 256 * 1024)
+  EXPECT_LE(rss.back(), baseline + std::size_t{256} * 1024)
       << "resident memory grew by " << (rss.back() - baseline) / 1024 << " KiB from 09:00 to midnight";
-  EXPECT_LE(highest, baseline + 1536 * 1024) << "a peak of " << (highest - baseline) / 1024 << " KiB";
+  EXPECT_LE(highest, baseline + std::size_t{1536} * 1024) << "a peak of " << (highest - baseline) / 1024 << " KiB";
   for (int hour = 2; hour < kHours; ++hour) EXPECT_EQ(fds[static_cast<std::size_t>(hour)], fds[2]) << "hour " << hour;
   const FrameFigures figures = board.frameFigures();
   EXPECT_GT(figures.frames, 0);

@@ -216,7 +216,7 @@ TEST_F(StatusServer, EachControlAnswersWhatItDid) {
 TEST_F(StatusServer, MalformedAndOversizedRequestsAreRefused) {
   // A request line that is not HTTP gets a 400 or the connection closed, never an answer.
   for (const std::string& request : std::vector<std::string>{"HELLO THERE\r\n\r\n", "GET /health HTTP/9.9\r\n\r\n",
-                                                             std::string("\0\xff\xfe junk\r\n\r\n", 14)}) {
+                                                             std::string("\0\xff\xfe junk\r\n\r\n", 12)}) {
     const std::string answer = show_->raw(request);
     EXPECT_TRUE(answer.empty() || answer.starts_with("HTTP/1.1 400")) << request << " -> " << answer;
   }

@@ -67,7 +67,7 @@ TEST(KioskPolicy, AWeekAtTheMuseum) {
   const Manifest m = museum();
   Schedule schedule = scheduleOf(m);
   // Monday 2026-03-23 00:00 in Paris is Sunday 23:00 UTC.
-  const WallTime mondayMidnight{seconds(daysFromCivil(2026, 3, 22) * 86400 + 23 * 3600)};
+  const WallTime mondayMidnight{seconds(daysFromCivil(2026, 3, 22) * 86400 + std::int64_t{23} * 3600)};
   ManualClock clock(Nanos{0}, mondayMidnight);
   KioskPolicy policy(m, schedule);
   policy.start(clock.now(), clock.wallNow());
@@ -129,7 +129,7 @@ TEST(KioskPolicy, OpeningFollowsLocalTimeAcrossTheChangeToSummerTime) {
   const Manifest m = museum();
   const Schedule s = scheduleOf(m);
   const auto at = [](int d, int h, int min) {
-    return WallTime{seconds(daysFromCivil(2026, 3, static_cast<unsigned>(d)) * 86400 + h * 3600 + min * 60)};
+    return WallTime{seconds(daysFromCivil(2026, 3, static_cast<unsigned>(d)) * 86400 + std::int64_t{h} * 3600 + std::int64_t{min} * 60)};
   };
   EXPECT_FALSE(s.isOpen(at(28, 8, 59)));
   EXPECT_TRUE(s.isOpen(at(28, 9, 0))) << "Saturday 10:00 CET is 09:00 UTC";
@@ -147,7 +147,7 @@ TEST(KioskPolicy, OpeningFollowsLocalTimeAcrossTheChangeToSummerTime) {
 
 TEST(KioskPolicy, OutsideHoursTheScreenIsBlackOrOff) {
   Manifest m = museum();
-  const WallTime monday{seconds(daysFromCivil(2026, 3, 23) * 86400 + 12 * 3600)};
+  const WallTime monday{seconds(daysFromCivil(2026, 3, 23) * 86400 + std::int64_t{12} * 3600)};
   m.kiosk.schedule.outside = OutsideHours::kBlack;
   KioskPolicy black(m, scheduleOf(m));
   black.start(Nanos{0}, monday);
