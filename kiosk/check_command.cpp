@@ -7,19 +7,67 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/std.h>
 
 #include "kiosk/check_mdl.h"
 #include "kiosk/commands.h"
+#include "kiosk/manifest.h"
 #include "kiosk/options.h"
+#include "media/image_io.h"
+#include "runtime/script/interpreter.h"
 
 namespace basalt::kiosk {
 
 namespace {
 
+/// A show manifest: every section and every file it names (kiosk/check_manifest.cpp prints
+/// the problems and a summary line).
+CheckResult checkToml(const std::filesystem::path& file) {
+  CheckResult result;
+  result.errors = checkManifestFile(file, stdout) == 0 ? 0 : 1;
+  result.items = 1;
+  return result;
+}
+
 // One line per kind of file; the checker lives in its own file.
 constexpr FileChecker kCheckers[] = {
+    {".toml", "show manifest", "manifests", checkToml},
     {".mdl", "LAVA script", "commands", checkMdl},
 };
+
+/// Images a manifest names (textures, fallbacks) must decode.
+std::vector<Diagnostic> checkImageContent(const std::filesystem::path& file) {
+  std::vector<Diagnostic> out;
+  auto image = media::readImage(file);
+  if (!image) {
+    out.push_back({Severity::kError, file, 0, fmt::format("cannot be read as an image: {}", image.error().message())});
+  } else if (image->empty()) {
+    out.push_back({Severity::kError, file, 0, "the image is empty (0 pixels)"});
+  }
+  return out;
+}
+
+/// A script a manifest names: what `basalt check SCRIPT.mdl` finds, as the manifest's problems.
+std::vector<Diagnostic> checkScriptContent(const std::filesystem::path& file) {
+  std::vector<Diagnostic> out;
+  auto interpreter = script::Interpreter::load(file);
+  if (!interpreter) {
+    out.push_back({Severity::kError, file, 0, interpreter.error().message()});
+    return out;
+  }
+  const script::Program& program = interpreter->program();
+  const std::filesystem::path folder = file.parent_path().empty() ? "." : file.parent_path();
+  std::vector<script::Diagnostic> found = program.diagnostics;
+  for (script::Diagnostic& d : checkScriptStatically(program, folder)) found.push_back(std::move(d));
+  script::sortByLine(found);
+  for (const script::Diagnostic& d : found) {
+    const Severity severity = d.severity == script::Severity::kError     ? Severity::kError
+                              : d.severity == script::Severity::kWarning ? Severity::kWarning
+                                                                         : Severity::kNote;
+    out.push_back({severity, file, static_cast<int>(d.line), d.message});
+  }
+  return out;
+}
 
 std::string lowerExtension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -40,11 +88,25 @@ std::string knownKinds() {
 
 std::span<const FileChecker> fileCheckers() { return kCheckers; }
 
+const std::map<std::string, ContentChecker, std::less<>>& contentCheckers() {
+  static const std::map<std::string, ContentChecker, std::less<>> checkers{
+      {".png", checkImageContent}, {".jpg", checkImageContent}, {".jpeg", checkImageContent},
+      {".tif", checkImageContent}, {".tiff", checkImageContent}, {".exr", checkImageContent},
+      {".ppm", checkImageContent}, {".pgm", checkImageContent}, {".pnm", checkImageContent},
+      {".tga", checkImageContent}, {".bmp", checkImageContent}, {".hdr", checkImageContent},
+      {".mdl", checkScriptContent},
+  };
+  return checkers;
+}
+
 std::string_view checkUsage() {
   return R"(Usage: basalt check FILE...
 
 Finds every error in the files of a show without running anything, and prints each as
 `file:line: error: what is wrong`. The kind of file is told by its extension:
+  .toml   show manifest: its outputs, views, entry, media, devices and bindings,
+          textures, kiosk policy and status server; every file it names must exist
+          inside the show folder and parse
   .mdl    LAVA script (the commands of 'basalt help script'): unknown commands and
           values (with a "did you mean"), wrong forms, unbalanced loops, files that are
           missing or outside the script's folder, parts the start-up cube does not have

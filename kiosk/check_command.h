@@ -6,6 +6,7 @@
 /// (check_command.cpp holds the table; each checker lives in its own file).
 
 #include <cstddef>
+#include <cstdio>
 #include <filesystem>
 #include <span>
 #include <string_view>
@@ -30,6 +31,10 @@ struct FileChecker {
 
 /// \brief Every kind of file `basalt check` knows.
 std::span<const FileChecker> fileCheckers();
+
+/// \brief Checks a show manifest and everything it refers to (kiosk/check_manifest.cpp).
+/// Prints each problem on `out`; returns 0 when there is no error, 1 otherwise.
+int checkManifestFile(const std::filesystem::path& file, std::FILE* out);
 
 std::string_view checkUsage();
 /// \brief `basalt check ...`: 0 when every file is free of errors, 1 when one has errors or

@@ -1,6 +1,9 @@
 #include "kiosk/frame_loop.h"
 
 #include <chrono>
+#include <optional>
+
+#include <fmt/format.h>
 
 #include "runtime/log.h"
 
@@ -49,12 +52,41 @@ bool FrameLoop::participantWantsStop() const {
   return false;
 }
 
+Result<void> FrameLoop::waitForOutput() {
+  // A KMS output is not ready while its last page flip is pending; the flip's event arrives on
+  // paceFd(), which the event loop watches. A flip that never completes is a driver fault: say
+  // so rather than hang (the watchdog would restart us, without a message).
+  const SystemClock wall;
+  const Nanos giveUp = wall.now() + std::chrono::seconds(2);
+  while (!output_.readyForFrame() && !stopRequested_) {
+    if (wall.now() > giveUp) {
+      return fail(Errc::kTimeout, fmt::format("the {} output did not finish presenting within 2 s", output_.kind()));
+    }
+    if (auto r = loop_.dispatch(std::chrono::milliseconds(100)); !r) return std::unexpected(r.error());
+  }
+  return {};
+}
+
 Result<FrameLoopStats> FrameLoop::run() {
   FrameLoopStats stats;
   const SystemClock wall;
   const Nanos wallStart = wall.now();
   const Nanos start = clock_.now();
+  std::optional<runtime::EventLoop::Handle> pace;
+  if (output_.paceFd() >= 0) {
+    auto watched = loop_.watchFd(output_.paceFd(), EPOLLIN, [this](std::uint32_t) { output_.onPaceReady(); });
+    if (!watched) return std::unexpected(watched.error());
+    pace = *watched;
+  }
+  struct Unwatch {
+    runtime::EventLoop& loop;
+    std::optional<runtime::EventLoop::Handle>& handle;
+    ~Unwatch() {
+      if (handle) loop.unwatch(*handle);
+    }
+  } unwatch{loop_, pace};
   for (std::int64_t frame = 0; config_.maxFrames < 0 || frame < config_.maxFrames; ++frame) {
+    if (auto r = waitForOutput(); !r) return std::unexpected(r.error());
     const Nanos due = start + frameTime(frame, config_.fps);
     if (manual_) {
       manual_->set(due);

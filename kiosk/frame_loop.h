@@ -106,6 +106,8 @@ class FrameLoop {
 
  private:
   void applyInput(Nanos until);
+  /// Waits, serving the event loop, until the output can take the next frame (paced outputs).
+  Result<void> waitForOutput();
   /// Draws one frame; `context.last` becomes true when a participant asks to stop during it.
   Result<void> renderFrame(FrameContext& context);
   [[nodiscard]] bool participantWantsStop() const;

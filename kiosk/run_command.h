@@ -10,6 +10,8 @@
 #include <string_view>
 
 #include "kiosk/video_streams.h"
+#include "render/output.h"
+#include "runtime/clock.h"
 #include "runtime/error.h"
 
 namespace basalt::kiosk {
@@ -20,11 +22,19 @@ enum class ClockMode : std::uint8_t { kAuto, kSystem, kManual };
 
 /// \brief Options of `basalt run`.
 struct RunOptions {
-  bool help = false;                          ///< --help was given
-  std::optional<std::filesystem::path> show;  ///< the show to play: a LAVA script (.mdl)
-  std::optional<std::int64_t> frames;         ///< stop after this many frames
-  std::optional<double> seconds;              ///< stop after this much show time
-  std::uint32_t width = 500;                  ///< LAVA's start-up window is 500 x 500
+  bool help = false;                              ///< --help was given
+  std::optional<std::filesystem::path> manifest;  ///< the show.toml to play; none: the default show
+  std::optional<std::filesystem::path> show;      ///< a LAVA script (.mdl) to play on the default show
+  std::optional<render::OutputKind> output;       ///< --output (or --headless); none: the manifest's
+  bool sizeGiven = false;                         ///< --size was given (else the manifest's size)
+  bool fpsGiven = false;                          ///< --fps was given (else the manifest's)
+  std::optional<std::filesystem::path> stateDir;  ///< where the resume point is kept
+  bool resume = true;                             ///< --no-resume starts from the beginning
+  std::optional<WallTime> clockStart;             ///< the manual clock's calendar start (schedules)
+  std::optional<std::string> statusListen;        ///< --status ADDRESS:PORT
+  std::optional<std::int64_t> frames;             ///< stop after this many frames
+  std::optional<double> seconds;                  ///< stop after this much show time
+  std::uint32_t width = 500;                      ///< LAVA's start-up window is 500 x 500
   std::uint32_t height = 500;
   bool headless = false;                          ///< force the offscreen output
   std::optional<std::filesystem::path> snapshot;  ///< where the last frame goes

@@ -128,6 +128,20 @@ Result<void> writeAtomically(const std::filesystem::path& path, WriteFn&& write)
   return {};
 }
 
+png_image pngHeaderFor(const Image& image) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = image.width;
+  png.height = image.height;
+  switch (image.channels) {
+    case 1: png.format = PNG_FORMAT_GRAY; break;
+    case 2: png.format = PNG_FORMAT_GA; break;
+    case 3: png.format = PNG_FORMAT_RGB; break;
+    default: png.format = PNG_FORMAT_RGBA; break;
+  }
+  return png;
+}
+
 Result<void> writePng(const std::filesystem::path& path, const Image& image) {
   png_image png{};
   png.version = PNG_IMAGE_VERSION;
@@ -184,6 +198,29 @@ Result<void> writeBytes(const std::filesystem::path& path, const std::vector<std
 }
 
 }  // namespace
+
+Result<std::vector<std::uint8_t>> encodePng(const Image& image) {
+  if (image.type != ChannelType::kU8 || image.channels < 1 || image.channels > 4 || image.empty()) {
+    return fail(Errc::kInvalidArgument, "only non-empty 8-bit images with 1 to 4 channels are encoded as PNG");
+  }
+  png_image png = pngHeaderFor(image);
+  png_alloc_size_t size = 0;
+  const auto stride = static_cast<png_int_32>(image.rowBytes());
+  if (!png_image_write_to_memory(&png, nullptr, &size, 0, image.pixels.data(), stride, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return fail(Errc::kIo, fmt::format("cannot encode the PNG: {}", message));
+  }
+  std::vector<std::uint8_t> bytes(size);
+  png = pngHeaderFor(image);
+  if (!png_image_write_to_memory(&png, bytes.data(), &size, 0, image.pixels.data(), stride, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return fail(Errc::kIo, fmt::format("cannot encode the PNG: {}", message));
+  }
+  bytes.resize(size);
+  return bytes;
+}
 
 Result<void> writeImage(const std::filesystem::path& path, const Image& image) {
   if (image.empty() || image.channels < 1 || image.channels > 4 || image.pixels.size() < image.byteSize()) {
