@@ -200,7 +200,8 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
     if (o.name.empty()) {
       if (run.manifest || run.show) {
         return fail(Errc::kInvalidArgument,
-                    fmt::format("unexpected argument '{}': 'basalt run' plays one show at a time", o.value));
+                    fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
+                                (run.manifest ? *run.manifest : *run.show).string()));
       }
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
       if (o.value.ends_with(".toml")) {
@@ -405,7 +406,10 @@ int runShow(const RunOptions& options) {
 
   const std::filesystem::path snapshotPath = options.snapshot ? *options.snapshot : options.outputDir / "snapshot.png";
   if (options.show && !isScriptFile(*options.show)) {
-    return usageError(fmt::format("basalt run plays LAVA scripts (.mdl); '{}' is not one", options.show->string()));
+    return usageError(
+        fmt::format("basalt run plays show manifests and LAVA scripts (.mdl); '{}' is neither: give a show manifest "
+                    "(show.toml) or a script",
+                    options.show->string()));
   }
   if (auto r = checkWritableFolder(snapshotPath); !r) return failWith(r.error(), "cannot start");
   if (options.statusListen) {

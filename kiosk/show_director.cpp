@@ -305,7 +305,7 @@ void ShowDirector::applyInput(Nanos until) {
                                // A visitor touched something: wake the exhibit, and count as activity.
                                if (policy_->noteInput(now)) applyProgramme(now);
                                if (!player_) return;
-                               const DeviceSlot& slot = show_->devices[e.device - 1];
+                               DeviceSlot& slot = show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
                                if (e.kind == EventKind::kButton) {
                                  if (e.value < 0.5 || e.index >= slot.buttons.size()) return;
                                  switch (slot.buttons[e.index]) {

@@ -110,7 +110,7 @@ TEST(ScriptCli, RunRefusesWhatItCannotPlay) {
   EXPECT_NE(missing.output.find("missing.mdl"), std::string::npos) << missing.output;
   const auto other = basalt({"run", "show.xyz"});
   EXPECT_EQ(other.exitCode, 2);
-  EXPECT_NE(other.output.find("plays LAVA scripts (.mdl)"), std::string::npos) << other.output;
+  EXPECT_NE(other.output.find("plays show manifests and LAVA scripts (.mdl)"), std::string::npos) << other.output;
   const auto two = basalt({"run", "a.mdl", "b.mdl"});
   EXPECT_EQ(two.exitCode, 2);
 }

@@ -448,8 +448,8 @@ TEST(CheckCommand, PrintsFileLineMessagesAndFails) {
   EXPECT_NE(r.output.find(":3: devices.x: needs backend"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("2 problems; the show will not start until they are fixed"), std::string::npos) << r.output;
   const auto unknown = test::run({(test::binaryDir() / "basalt").string(), "check", "readme.txt"});
-  EXPECT_EQ(unknown.exitCode, 1);
-  EXPECT_NE(unknown.output.find("does not know .txt files"), std::string::npos) << unknown.output;
+  EXPECT_EQ(unknown.exitCode, 2) << "a file of an unknown kind is a usage error";
+  EXPECT_NE(unknown.output.find("does not know '.txt' files"), std::string::npos) << unknown.output;
   const auto usage = test::run({(test::binaryDir() / "basalt").string(), "check"});
   EXPECT_EQ(usage.exitCode, 2) << usage.output;
 }
