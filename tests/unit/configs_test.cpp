@@ -28,11 +28,12 @@ std::string read(const std::filesystem::path& p) {
 
 TEST(SystemdUnit, HasWhatAKioskServiceNeeds) {
   const std::string unit = read(test::sourceDir() / "configs/systemd/basalt.service");
-  for (const char* line : {"Type=notify", "WatchdogSec=10", "Restart=always", "NoNewPrivileges=yes",
-                           "ProtectSystem=strict", "ProtectHome=yes", "PrivateTmp=yes", "DevicePolicy=closed",
-                           "DeviceAllow=char-drm rw", "DeviceAllow=char-video4linux rw", "DeviceAllow=char-hidraw rw",
-                           "DeviceAllow=char-usb_device rw", "StateDirectory=basalt",
-                           "ExecReload=/bin/kill -HUP $MAINPID", "StartLimitIntervalSec=0", "CapabilityBoundingSet="}) {
+  for (const char* line :
+       {"Type=notify", "WatchdogSec=10", "Restart=always", "NoNewPrivileges=yes", "ProtectSystem=strict",
+        "ProtectHome=yes", "PrivateTmp=yes", "DevicePolicy=closed", "DeviceAllow=char-drm rw",
+        "DeviceAllow=char-video4linux rw", "DeviceAllow=char-media rw", "DeviceAllow=char-hidraw rw",
+        "DeviceAllow=char-ttyUSB rw", "DeviceAllow=char-usb_device rw", "StateDirectory=basalt",
+        "ExecReload=/bin/kill -HUP $MAINPID", "StartLimitIntervalSec=0", "CapabilityBoundingSet="}) {
     EXPECT_NE(unit.find(std::string("\n") + line + "\n"), std::string::npos) << line;
   }
   EXPECT_EQ(unit.find("MemoryDenyWriteExecute=yes"), std::string::npos)
