@@ -19,6 +19,7 @@
 #include "kiosk/frame_metrics.h"
 #include "kiosk/manifest.h"
 #include "kiosk/options.h"
+#include "kiosk/readers.h"
 #include "kiosk/script_player.h"
 #include "kiosk/show_director.h"
 #include "kiosk/show_loader.h"
@@ -396,6 +397,7 @@ Result<void> applyStatusListen(std::string_view listen, StatusSpec& spec) {
 }  // namespace
 
 int runShow(const RunOptions& options) {
+  registerContentReaders();
   Manifest manifest = Manifest::builtinDefault();
   if (options.manifest) {
     auto read = readShowManifest(*options.manifest);

@@ -221,7 +221,8 @@ void ShowDirector::handleControls(const FrameContext& frame) {
         }
         break;
       case ControlKind::kRunCommand: {
-        auto out = runScriptCommand(request.argument, context_.show);
+        auto out = runScriptCommand(request.argument, {context_.show, &context_.renderer.textures(),
+                                                       show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
         if (out) {
           reply.answer(200, *out);
         } else {
@@ -356,6 +357,7 @@ void ShowDirector::applyProgramme(Nanos now) {
         started = std::unexpected(why != show_->unplayable.end() ? why->second
                                                                  : Error(Errc::kInternal, "item was not prepared"));
       } else {
+        found->second->useTextures(context_.renderer.textures());
         started = found->second->start(context_.show, now - p.itemStart, context_.fps);
       }
       if (!started) {
