@@ -33,12 +33,9 @@ CheckResult checkToml(const std::filesystem::path& file) {
 
 // One line per kind of file; the checker lives in its own file.
 constexpr FileChecker kCheckers[] = {
-    {".toml", "show manifest", "manifests", checkToml},
-    {".mdl", "LAVA script", "commands", checkMdl},
-    {".sce", "scene", "imports", checkSceneFile},
-    {".obj", "Wavefront OBJ model", "objects", checkModelFile},
-    {".off", "OFF model", "objects", checkModelFile},
-    {".cave", "cave file", "facets", checkCaveFile},
+    {".toml", "show manifest", "manifests", checkToml}, {".mdl", "LAVA script", "commands", checkMdl},
+    {".sce", "scene", "imports", checkSceneFile},       {".obj", "Wavefront OBJ model", "objects", checkModelFile},
+    {".off", "OFF model", "objects", checkModelFile},   {".cave", "cave file", "facets", checkCaveFile},
 };
 
 /// Images a manifest names (textures, fallbacks) must decode.
@@ -96,11 +93,11 @@ std::span<const FileChecker> fileCheckers() { return kCheckers; }
 
 const std::map<std::string, ContentChecker, std::less<>>& contentCheckers() {
   static const std::map<std::string, ContentChecker, std::less<>> checkers{
-      {".png", checkImageContent}, {".jpg", checkImageContent}, {".jpeg", checkImageContent},
-      {".tif", checkImageContent}, {".tiff", checkImageContent}, {".exr", checkImageContent},
-      {".ppm", checkImageContent}, {".pgm", checkImageContent}, {".pnm", checkImageContent},
-      {".tga", checkImageContent}, {".bmp", checkImageContent}, {".hdr", checkImageContent},
-      {".mdl", checkScriptContent}, {".sce", checkSceneContent}, {".obj", checkModelContent},
+      {".png", checkImageContent},  {".jpg", checkImageContent},  {".jpeg", checkImageContent},
+      {".tif", checkImageContent},  {".tiff", checkImageContent}, {".exr", checkImageContent},
+      {".ppm", checkImageContent},  {".pgm", checkImageContent},  {".pnm", checkImageContent},
+      {".tga", checkImageContent},  {".bmp", checkImageContent},  {".hdr", checkImageContent},
+      {".mdl", checkScriptContent}, {".sce", checkSceneContent},  {".obj", checkModelContent},
       {".off", checkModelContent},  {".cave", checkCaveContent},
   };
   return checkers;

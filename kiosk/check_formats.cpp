@@ -41,7 +41,8 @@ Diagnostic fromWhere(Severity severity, const std::string& where, std::string me
 }
 
 void addWarnings(Findings& f, const std::vector<formats::Diagnostic>& warnings, const std::filesystem::path& file) {
-  for (const formats::Diagnostic& w : warnings) f.problems.push_back(fromWhere(Severity::kWarning, w.where, w.message, file));
+  for (const formats::Diagnostic& w : warnings)
+    f.problems.push_back(fromWhere(Severity::kWarning, w.where, w.message, file));
 }
 
 void addError(Findings& f, const Error& error, const std::filesystem::path& file) {
@@ -77,8 +78,8 @@ Findings findScene(const std::filesystem::path& file) {
   addWarnings(f, scene->warnings, file);
   f.items = scene->description.sources.size();
   if (f.items > 0 && scene->models.empty() && scene->terrains.empty()) {
-    f.problems.push_back({Severity::kError, file, 0,
-                          fmt::format("nothing to show: none of its {} imports could be loaded", f.items)});
+    f.problems.push_back(
+        {Severity::kError, file, 0, fmt::format("nothing to show: none of its {} imports could be loaded", f.items)});
   }
   return f;
 }

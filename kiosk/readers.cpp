@@ -97,8 +97,8 @@ Result<std::unique_ptr<ItemPlayer>> makeModelItem(const EntrySpec& entry, const 
   PreparedImages images;
   readOwnTextures(show, manifest, entry.path.string(), images);
   const formats::ModelCounts counts = formats::countModel(*model);
-  log::info(kLogItems, "{}: model {}: {} objects, {} triangles, {} warnings", entryWhere(entry, manifest),
-            entry.text, counts.objects, counts.triangles, model->warnings.size());
+  log::info(kLogItems, "{}: model {}: {} objects, {} triangles, {} warnings", entryWhere(entry, manifest), entry.text,
+            counts.objects, counts.triangles, model->warnings.size());
   return std::make_unique<PreparedItem>(std::move(show), std::move(images));
 }
 
@@ -173,7 +173,8 @@ Result<std::unique_ptr<ItemPlayer>> makeScriptItem(const EntrySpec& entry, const
     if (d.severity == script::Severity::kNote) {
       log::info(kLogItems, "{}", d.describe());
     } else {
-      log::warn(kLogItems, "{}{}", d.describe(), d.severity == script::Severity::kError ? " (the line is skipped)" : "");
+      log::warn(kLogItems, "{}{}", d.describe(),
+                d.severity == script::Severity::kError ? " (the line is skipped)" : "");
     }
   }
   if (program.instrs.empty()) {
@@ -213,8 +214,8 @@ Result<std::string> runControlCommand(std::string_view command, const CommandTar
   if (program.instrs.empty()) return fail(Errc::kInvalidArgument, "nothing to run: the line has no command");
   const script::Action action = program.def(program.instrs.front()).action;
   if (action == script::Action::kQuit) {
-    return fail(Errc::kInvalidArgument,
-                fmt::format("'{}' cannot be run on its own from the control server", program.def(program.instrs.front()).name));
+    return fail(Errc::kInvalidArgument, fmt::format("'{}' cannot be run on its own from the control server",
+                                                    program.def(program.instrs.front()).name));
   }
   script::Interpreter interpreter(std::move(program), target.folder.empty() ? "." : target.folder);
   std::vector<script::Diagnostic> reported;

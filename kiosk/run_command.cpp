@@ -200,9 +200,8 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
   for (const ParsedOption& o : *parsed) {
     if (o.name.empty()) {
       if (run.manifest || run.show) {
-        return fail(Errc::kInvalidArgument,
-                    fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
-                                (run.manifest ? *run.manifest : *run.show).string()));
+        return fail(Errc::kInvalidArgument, fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
+                                                        (run.manifest ? *run.manifest : *run.show).string()));
       }
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
       if (o.value.ends_with(".toml")) {

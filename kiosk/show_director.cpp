@@ -221,8 +221,9 @@ void ShowDirector::handleControls(const FrameContext& frame) {
         }
         break;
       case ControlKind::kRunCommand: {
-        auto out = runScriptCommand(request.argument, {context_.show, &context_.renderer.textures(),
-                                                       show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
+        auto out =
+            runScriptCommand(request.argument, {context_.show, &context_.renderer.textures(),
+                                                show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
         if (out) {
           reply.answer(200, *out);
         } else {
@@ -306,7 +307,8 @@ void ShowDirector::applyInput(Nanos until) {
                                // A visitor touched something: wake the exhibit, and count as activity.
                                if (policy_->noteInput(now)) applyProgramme(now);
                                if (!player_) return;
-                               DeviceSlot& slot = show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
+                               DeviceSlot& slot =
+                                   show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
                                if (e.kind == EventKind::kButton) {
                                  if (e.value < 0.5 || e.index >= slot.buttons.size()) return;
                                  switch (slot.buttons[e.index]) {

@@ -182,8 +182,8 @@ Result<void> ShowHost::accumulateJitterPass(int /*pass*/, int /*passes*/) {
 }
 
 Result<void> ShowHost::tv(const script::TvRequest& request) {
-  return once(tvSaid_, fmt::format("a {} has no {} in this build; its tv commands are skipped from now on",
-                                   what_, request.op == script::TvOp::kCamera ? "camera" : "VCR (movie player)"));
+  return once(tvSaid_, fmt::format("a {} has no {} in this build; its tv commands are skipped from now on", what_,
+                                   request.op == script::TvOp::kCamera ? "camera" : "VCR (movie player)"));
 }
 
 }  // namespace basalt::kiosk

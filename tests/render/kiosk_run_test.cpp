@@ -33,6 +33,7 @@ TEST_P(ExampleRun, PlaysHeadless) {
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find(std::string("played '") + name + "': 30 frames"), std::string::npos) << r.output;
   EXPECT_TRUE(std::filesystem::exists(out / "snapshot.png"));
+  EXPECT_EQ(r.output.find("cannot play"), std::string::npos) << "every scripted and scene item plays: " << r.output;
 }
 
 INSTANTIATE_TEST_SUITE_P(Configs, ExampleRun,
