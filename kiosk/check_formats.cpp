@@ -1,5 +1,6 @@
 #include "kiosk/check_formats.h"
 
+#include <algorithm>
 #include <cctype>
 #include <string>
 
@@ -25,18 +26,22 @@ struct Findings {
 Diagnostic fromWhere(Severity severity, const std::string& where, std::string message,
                      const std::filesystem::path& fallback) {
   std::string file = where;
-  std::vector<int> numbers;
+  // Up to two trailing numbers: "...:line:column" or "...:line".
+  int last = -1;
+  int beforeLast = -1;
   for (int i = 0; i < 2; ++i) {
     const std::size_t colon = file.rfind(':');
     if (colon == std::string::npos || colon + 1 == file.size()) break;
     const std::string tail = file.substr(colon + 1);
     if (!std::all_of(tail.begin(), tail.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) break;
-    numbers.insert(numbers.begin(), std::stoi(tail));
+    beforeLast = last;
+    last = std::stoi(tail);
     file.resize(colon);
   }
   if (file.empty()) file = fallback.string();
-  const int line = numbers.empty() ? 0 : numbers[0];
-  if (numbers.size() > 1) message = fmt::format("column {}: {}", numbers[1], message);
+  // Read from the end: with two numbers, `last` is the line and `beforeLast` the column.
+  const int line = last < 0 ? 0 : last;
+  if (beforeLast >= 0) message = fmt::format("column {}: {}", beforeLast, message);
   return {severity, file, line, std::move(message)};
 }
 
@@ -99,7 +104,12 @@ Findings findCave(const std::filesystem::path& file) {
 CheckResult print(const Findings& f) {
   CheckResult result;
   for (const Diagnostic& d : f.problems) {
-    fmt::print("{}\n", d.format());
+    // As `basalt check SCRIPT.mdl` prints: "file:line: error: ...".
+    const std::string_view severity = d.severity == Severity::kError     ? "error"
+                                      : d.severity == Severity::kWarning ? "warning"
+                                                                         : "note";
+    fmt::print("{}{}: {}: {}\n", d.file.string(), d.line > 0 ? fmt::format(":{}", d.line) : std::string(), severity,
+               d.message);
     if (d.severity == Severity::kError) ++result.errors;
     if (d.severity == Severity::kWarning) ++result.warnings;
   }
