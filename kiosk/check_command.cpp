@@ -9,10 +9,12 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "kiosk/check_formats.h"
 #include "kiosk/check_mdl.h"
 #include "kiosk/commands.h"
 #include "kiosk/manifest.h"
 #include "kiosk/options.h"
+#include "kiosk/readers.h"
 #include "media/image_io.h"
 #include "runtime/script/interpreter.h"
 
@@ -31,8 +33,9 @@ CheckResult checkToml(const std::filesystem::path& file) {
 
 // One line per kind of file; the checker lives in its own file.
 constexpr FileChecker kCheckers[] = {
-    {".toml", "show manifest", "manifests", checkToml},
-    {".mdl", "LAVA script", "commands", checkMdl},
+    {".toml", "show manifest", "manifests", checkToml}, {".mdl", "LAVA script", "commands", checkMdl},
+    {".sce", "scene", "imports", checkSceneFile},       {".obj", "Wavefront OBJ model", "objects", checkModelFile},
+    {".off", "OFF model", "objects", checkModelFile},   {".cave", "cave file", "facets", checkCaveFile},
 };
 
 /// Images a manifest names (textures, fallbacks) must decode.
@@ -90,11 +93,12 @@ std::span<const FileChecker> fileCheckers() { return kCheckers; }
 
 const std::map<std::string, ContentChecker, std::less<>>& contentCheckers() {
   static const std::map<std::string, ContentChecker, std::less<>> checkers{
-      {".png", checkImageContent}, {".jpg", checkImageContent}, {".jpeg", checkImageContent},
-      {".tif", checkImageContent}, {".tiff", checkImageContent}, {".exr", checkImageContent},
-      {".ppm", checkImageContent}, {".pgm", checkImageContent}, {".pnm", checkImageContent},
-      {".tga", checkImageContent}, {".bmp", checkImageContent}, {".hdr", checkImageContent},
-      {".mdl", checkScriptContent},
+      {".png", checkImageContent},  {".jpg", checkImageContent},  {".jpeg", checkImageContent},
+      {".tif", checkImageContent},  {".tiff", checkImageContent}, {".exr", checkImageContent},
+      {".ppm", checkImageContent},  {".pgm", checkImageContent},  {".pnm", checkImageContent},
+      {".tga", checkImageContent},  {".bmp", checkImageContent},  {".hdr", checkImageContent},
+      {".mdl", checkScriptContent}, {".sce", checkSceneContent},  {".obj", checkModelContent},
+      {".off", checkModelContent},  {".cave", checkCaveContent},
   };
   return checkers;
 }
@@ -110,6 +114,11 @@ Finds every error in the files of a show without running anything, and prints ea
   .mdl    LAVA script (the commands of 'basalt help script'): unknown commands and
           values (with a "did you mean"), wrong forms, unbalanced loops, files that are
           missing or outside the script's folder, parts the start-up cube does not have
+  .sce    scene: every statement, and every model and terrain it imports
+  .obj    Wavefront OBJ model (plain or Extended), with its material libraries
+  .off    OFF model
+  .cave   cave file: its settings, and the cave geometry model it names (facets flat,
+          convex, the facet and side it names present)
 
 Options:
   -h, --help    this text
@@ -119,6 +128,7 @@ Exit status: 0 when no file has errors, 1 when one has (or cannot be read), 2 fo
 }
 
 int checkMain(std::span<const std::string_view> args) {
+  registerContentReaders();
   auto parsed = parseOptions("check", args, {{"--help|-h"}});
   if (!parsed) return usageError(parsed.error().describe());
   std::vector<std::filesystem::path> files;

@@ -19,6 +19,7 @@
 #include "kiosk/frame_metrics.h"
 #include "kiosk/manifest.h"
 #include "kiosk/options.h"
+#include "kiosk/readers.h"
 #include "kiosk/script_player.h"
 #include "kiosk/show_director.h"
 #include "kiosk/show_loader.h"
@@ -199,9 +200,8 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
   for (const ParsedOption& o : *parsed) {
     if (o.name.empty()) {
       if (run.manifest || run.show) {
-        return fail(Errc::kInvalidArgument,
-                    fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
-                                (run.manifest ? *run.manifest : *run.show).string()));
+        return fail(Errc::kInvalidArgument, fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
+                                                        (run.manifest ? *run.manifest : *run.show).string()));
       }
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
       if (o.value.ends_with(".toml")) {
@@ -396,6 +396,7 @@ Result<void> applyStatusListen(std::string_view listen, StatusSpec& spec) {
 }  // namespace
 
 int runShow(const RunOptions& options) {
+  registerContentReaders();
   Manifest manifest = Manifest::builtinDefault();
   if (options.manifest) {
     auto read = readShowManifest(*options.manifest);

@@ -20,8 +20,8 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "kiosk/show_host.h"
 #include "media/image_io.h"
-#include "runtime/formats/model.h"
 #include "runtime/log.h"
 
 namespace basalt::kiosk {
@@ -180,22 +180,8 @@ Result<const Image*> ScriptPlayer::currentPicture() {
 }
 
 Result<void> ScriptPlayer::loadObject(const std::filesystem::path& file, runtime::Show& show) {
-  auto model = formats::loadModel(file);
-  if (!model) return std::unexpected(model.error());
-  for (const formats::Diagnostic& w : model->warnings) warn(w.describe());
-  if (auto r = formats::replaceObject(show, *model); !r) return r;
-  // The parts name their textures by file (material maps, Extended OBJ colour and reflection
-  // maps); each file is read once, and one that cannot be read leaves its parts untextured.
-  for (runtime::PartId id = 0; id < show.partCount(); ++id) {
-    const runtime::PartState& part = show.part(id);
-    for (const std::string* name : {&part.texture, &part.reflectionTexture}) {
-      if (name->empty() || renderer_.textures().find(*name) != nullptr) continue;
-      auto image = media::readImage(*name);
-      auto uploaded = image ? renderer_.textures().setImage(*name, *image) : Result<void>(std::unexpected(image.error()));
-      if (!uploaded) warn(fmt::format("the texture of part '{}' is not shown: {}", part.name, uploaded.error().describe()));
-    }
-  }
-  return {};
+  return loadObjectWithTextures(file, show, &renderer_.textures(), nullptr,
+                                [this](std::string message) { warn(std::move(message)); });
 }
 
 Result<void> ScriptPlayer::loadTexture(const std::filesystem::path& file, const std::string& name) {
@@ -258,37 +244,6 @@ Result<void> ScriptPlayer::tv(const script::TvRequest& request) {
               "the movie player is not available to scripts in this build yet; the show goes on without the movie");
 }
 
-bool ScriptPlayer::renders(Feature feature) const {
-  // What render::Renderer draws today. As the renderer learns a feature, it moves up here, and
-  // scripts stop being told that it is not rendered yet.
-  switch (feature) {
-    case Feature::kRendered:
-    case Feature::kRasterOp:
-    case Feature::kMarkerShapes:
-    case Feature::kAntialiasing:
-    case Feature::kColorSelector:
-    case Feature::kLineStyle:
-    case Feature::kColorInterpolation:
-    case Feature::kFillStyle:
-    case Feature::kTransparency:
-    case Feature::kEdges:
-    case Feature::kDepthCue:
-    case Feature::kTexture:
-    case Feature::kModelClipping:
-    case Feature::kStereo:
-    case Feature::kFloor:
-    case Feature::kShadow: return true;
-    case Feature::kNurbs:
-    case Feature::kPicking:
-    case Feature::kAnnotation:
-    case Feature::kSingleBuffering:
-    case Feature::kViewMatrix:
-    case Feature::kDrawNoClear:
-    case Feature::kNoFinalMove:
-    case Feature::kJitterDisplay:
-    case Feature::kCount: return false;
-  }
-  return false;
-}
+bool ScriptPlayer::renders(Feature feature) const { return rendererDraws(feature); }
 
 }  // namespace basalt::kiosk

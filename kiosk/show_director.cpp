@@ -221,7 +221,9 @@ void ShowDirector::handleControls(const FrameContext& frame) {
         }
         break;
       case ControlKind::kRunCommand: {
-        auto out = runScriptCommand(request.argument, context_.show);
+        auto out =
+            runScriptCommand(request.argument, {context_.show, &context_.renderer.textures(),
+                                                show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
         if (out) {
           reply.answer(200, *out);
         } else {
@@ -305,7 +307,8 @@ void ShowDirector::applyInput(Nanos until) {
                                // A visitor touched something: wake the exhibit, and count as activity.
                                if (policy_->noteInput(now)) applyProgramme(now);
                                if (!player_) return;
-                               DeviceSlot& slot = show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
+                               DeviceSlot& slot =
+                                   show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
                                if (e.kind == EventKind::kButton) {
                                  if (e.value < 0.5 || e.index >= slot.buttons.size()) return;
                                  switch (slot.buttons[e.index]) {
@@ -356,6 +359,7 @@ void ShowDirector::applyProgramme(Nanos now) {
         started = std::unexpected(why != show_->unplayable.end() ? why->second
                                                                  : Error(Errc::kInternal, "item was not prepared"));
       } else {
+        found->second->useTextures(context_.renderer.textures());
         started = found->second->start(context_.show, now - p.itemStart, context_.fps);
       }
       if (!started) {

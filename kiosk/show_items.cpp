@@ -48,7 +48,9 @@ std::string_view missingReader(EntryKind kind) {
     case EntryKind::kScript: return "this build has no LAVA script interpreter";
     case EntryKind::kScene: return "this build has no .sce scene reader";
     case EntryKind::kModel: return "this build has no model reader";
-    case EntryKind::kMovie: return "this build has no movie player";
+    case EntryKind::kMovie:
+      return "movies are not played as show items in this build yet; show the movie as a texture of a model "
+             "or scene ([media] and [textures] in show.toml)";
     case EntryKind::kBuiltinDefault:
     case EntryKind::kBuiltinBlack: break;
   }
@@ -87,7 +89,7 @@ void setCommandRunner(CommandRunner runner) {
   r.commands = std::move(runner);
 }
 
-Result<std::string> runScriptCommand(std::string_view command, runtime::Show& show) {
+Result<std::string> runScriptCommand(std::string_view command, const CommandTarget& target) {
   CommandRunner runner;
   {
     Registry& r = registry();
@@ -97,7 +99,7 @@ Result<std::string> runScriptCommand(std::string_view command, runtime::Show& sh
   if (!runner) {
     return fail(Errc::kUnsupported, "this build has no LAVA script interpreter to run the command");
   }
-  return runner(command, show);
+  return runner(command, target);
 }
 
 }  // namespace basalt::kiosk

@@ -10,6 +10,7 @@
 /// such an item fails with a message that says so, and the kiosk moves on (DESIGN.md §8: the
 /// show goes on).
 
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -17,6 +18,7 @@
 
 #include "kiosk/frame_loop.h"
 #include "kiosk/manifest.h"
+#include "render/texture_registry.h"
 #include "runtime/error.h"
 #include "runtime/show/show.h"
 
@@ -29,6 +31,9 @@ namespace basalt::kiosk {
 class ItemPlayer {
  public:
   virtual ~ItemPlayer() = default;
+  /// \brief The renderer's textures, for items that bring images of their own (a model's maps,
+  /// a scene's background, a script's load_texture). Called before each start().
+  virtual void useTextures(render::TextureRegistry& textures) { (void)textures; }
   /// \brief Replaces what the show holds with this item, `position` into it (a resumed show).
   /// Must be quick: the frame it is called in must still be on time.
   [[nodiscard]] virtual Result<void> start(runtime::Show& show, Nanos position, double fps) = 0;
@@ -52,11 +57,18 @@ void setItemFactory(EntryKind kind, ItemFactory factory);
 /// \brief The player of `entry`, or why it cannot be played in this build.
 [[nodiscard]] Result<std::unique_ptr<ItemPlayer>> prepareItem(const EntrySpec& entry, const Manifest& show);
 
+/// \brief What a control command runs on.
+struct CommandTarget {
+  runtime::Show& show;
+  render::TextureRegistry* textures = nullptr;  ///< null: load_texture is not available
+  std::filesystem::path folder;                 ///< file names are relative to it (the show's folder)
+};
+
 /// \brief Runs one LAVA script command on the show (the control server's "run a command").
-using CommandRunner = std::function<Result<std::string>(std::string_view command, runtime::Show& show)>;
+using CommandRunner = std::function<Result<std::string>(std::string_view command, const CommandTarget& target)>;
 /// \brief Registers the script interpreter's command runner (call before the first show loads).
 void setCommandRunner(CommandRunner runner);
 /// \brief Runs `command`, or says that this build cannot.
-[[nodiscard]] Result<std::string> runScriptCommand(std::string_view command, runtime::Show& show);
+[[nodiscard]] Result<std::string> runScriptCommand(std::string_view command, const CommandTarget& target);
 
 }  // namespace basalt::kiosk

@@ -1,8 +1,10 @@
 // The show director in the frame loop, headless on a ManualClock, every frame read back: a
 // reload takes over between two frames and never shows a black frame (and a broken manifest
 // leaves the old show playing); dials turn the show through their bindings and buttons move the
-// playlist; a visitor wakes the attract loop; items this build cannot play are skipped, and when
-// none can, the screen is black rather than stuck; outside opening hours the display goes off
+// playlist; a visitor wakes the attract loop; items that cannot play (a scene with nothing to
+// show, a movie) are skipped, and when none can, the screen is black rather than stuck; scripts,
+// scenes and models play as items (a script that ends or quits moves the playlist on); control
+// commands run on the show; outside opening hours the display goes off
 // (black where the output has no display to switch); a stream texture shows its fallback.
 // Example failures: a black frame while the new show loads; a reload error that stops the show;
 // a button that does nothing; an unplayable item retried every frame.
@@ -14,6 +16,7 @@
 
 #include "kiosk/frame_loop.h"
 #include "kiosk/manifest.h"
+#include "kiosk/readers.h"
 #include "kiosk/show_director.h"
 #include "kiosk/show_loader.h"
 #include "kiosk/status_board.h"
@@ -54,7 +57,9 @@ class FrameRecorder final : public FrameParticipant {
 class Harness {
  public:
   explicit Harness(const std::string& name, WallTime wallStart = WallTime{std::chrono::hours(24 * 20000)})
-      : dir_(test::scratchDir("director-" + name)), clock_(Nanos{0}, wallStart), board_(wallStart, 30) {}
+      : dir_(test::scratchDir("director-" + name)), clock_(Nanos{0}, wallStart), board_(wallStart, 30) {
+    registerContentReaders();
+  }
 
   bool open(std::string& why) {
     auto output = render::createHeadlessOutput({48, 48});
@@ -244,36 +249,40 @@ items = [ { entry = "default", name = "attract" } ]
   EXPECT_EQ(h.recorder().blackFrames(), 0u);
 }
 
-TEST(ShowDirector, ItemsThisBuildCannotPlayAreSkipped) {
+TEST(ShowDirector, ItemsThatCannotPlayAreSkipped) {
   Harness h("unplayable");
   OPEN_OR_SKIP(h);
-  std::ofstream(h.dir() / "tour.mdl") << "draw\n";
-  std::ofstream(h.dir() / "wall.sce") << "import wall.obj\n";
+  std::ofstream(h.dir() / "wall.sce") << "import gone.obj\n";
+  std::ofstream(h.dir() / "clip.webm") << "not a movie";
   ASSERT_TRUE(h.install(R"(
 [[kiosk.playlist]]
-name = "tour"
-entry = "tour.mdl"
+name = "wall"
+entry = "wall.sce"
+duration = "10s"
 [[kiosk.playlist]]
 name = "cube"
 entry = "default"
 duration = "10s"
 )"));
-  EXPECT_EQ(h.item(), "cube") << "the script cannot play in this build: the cube plays";
+  EXPECT_EQ(h.item(), "cube") << "the scene imports nothing that loads: the cube plays";
   h.run(5);
   EXPECT_EQ(h.recorder().blackFrames(), 0u);
   const StatusSnapshot s = h.board().snapshot(WallTime{});
   bool said = false;
-  for (const auto& r : s.lastErrors) said = said || r.message.find("'tour' cannot play") != std::string::npos;
+  for (const auto& r : s.lastErrors) {
+    said = said || (r.message.find("'wall' cannot play") != std::string::npos &&
+                    r.message.find("none of its 1 imports could be loaded") != std::string::npos);
+  }
   EXPECT_TRUE(said) << "the operator is told why";
 
   Harness none("none-playable");
   OPEN_OR_SKIP(none);
-  std::ofstream(none.dir() / "tour.mdl") << "draw\n";
-  std::ofstream(none.dir() / "wall.sce") << "import wall.obj\n";
+  std::ofstream(none.dir() / "clip.webm") << "not a movie";
+  std::ofstream(none.dir() / "wall.sce") << "import gone.obj\n";
   ASSERT_TRUE(none.install(R"(
 [[kiosk.playlist]]
-name = "tour"
-entry = "tour.mdl"
+name = "clip"
+entry = "clip.webm"
 [[kiosk.playlist]]
 name = "wall"
 entry = "wall.sce"
@@ -283,6 +292,86 @@ duration = "10s"
   EXPECT_EQ(none.item(), "");
   EXPECT_EQ(none.recorder().blackFrames(), 5u) << "nothing can play: black, and the loop goes on";
   EXPECT_EQ(none.board().snapshot(WallTime{}).show.display, "black");
+}
+
+constexpr const char* kTriangle = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n";
+
+TEST(ShowDirector, AScriptItemPlaysToItsEndAndThePlaylistMovesOn) {
+  Harness h("script-item");
+  OPEN_OR_SKIP(h);
+  std::ofstream(h.dir() / "tri.obj") << kTriangle;
+  std::ofstream(h.dir() / "tour.mdl") << "load_object tri.obj\nloop 3\n  position.global_y_rotate = 5\n  draw\n"
+                                         "end_loop\nsave_image\n";
+  std::ofstream(h.dir() / "quits.mdl") << "draw\nquit\ndraw\n";
+  ASSERT_TRUE(h.install(R"(
+[[kiosk.playlist]]
+name = "tour"
+entry = "tour.mdl"
+[[kiosk.playlist]]
+name = "quits"
+entry = "quits.mdl"
+[[kiosk.playlist]]
+name = "cube"
+entry = "default"
+duration = "10s"
+)"));
+  EXPECT_EQ(h.item(), "tour");
+  h.run(2);
+  EXPECT_EQ(h.item(), "tour") << "three draws: still playing";
+  EXPECT_EQ(h.show().partCount(), 1u) << "load_object put the triangle on the show";
+  h.run(2);
+  EXPECT_EQ(h.item(), "quits") << "the script ended: the next item plays";
+  h.run(2);
+  EXPECT_EQ(h.item(), "cube") << "quit ends the item";
+  EXPECT_EQ(h.show().partCount(), 6u);
+  EXPECT_EQ(h.recorder().blackFrames(), 0u);
+}
+
+TEST(ShowDirector, SceneAndModelItemsPlay) {
+  Harness h("scene-model");
+  OPEN_OR_SKIP(h);
+  std::ofstream(h.dir() / "tri.obj") << kTriangle;
+  std::ofstream(h.dir() / "room.sce") << "bgcolor[0,0,0]\nposition[0,0,4]\n"
+                                         "light position[0,0,10,0] ambient[90,90,90] diffuse[230,230,230] "
+                                         "specular[0,0,0]\nimport tri.obj\nimport tri.obj\n";
+  ASSERT_TRUE(h.install(R"(
+[[kiosk.playlist]]
+name = "room"
+entry = "room.sce"
+duration = "1s"
+[[kiosk.playlist]]
+name = "triangle"
+entry = "tri.obj"
+duration = "1s"
+)"));
+  EXPECT_EQ(h.item(), "room");
+  h.run(3);
+  EXPECT_EQ(h.show().nodes().size(), 2u) << "both imports are on the show";
+  EXPECT_TRUE(h.show().viewer().fromScene);
+  EXPECT_GT(h.recorder().lit().back(), 0u) << "the scene's triangles are drawn";
+  h.run(30);
+  EXPECT_EQ(h.item(), "triangle");
+  EXPECT_EQ(h.show().partCount(), 1u);
+  EXPECT_GT(h.recorder().lit().back(), 0u) << "the model is drawn";
+}
+
+TEST(ShowDirector, ControlCommandsRunOnTheShow) {
+  const auto dir = test::scratchDir("director-commands");
+  std::ofstream(dir / "tri.obj") << kTriangle;
+  runtime::Show show = runtime::Show::makeDefault();
+  const CommandTarget target{show, nullptr, dir};
+  auto ok = runControlCommand("load_object tri.obj", target);
+  ASSERT_TRUE(ok) << ok.error().describe();
+  EXPECT_NE(ok->find("ran: load_object tri.obj"), std::string::npos) << *ok;
+  EXPECT_EQ(show.partCount(), 1u);
+  auto gone = runControlCommand("load_object gone.obj", target);
+  ASSERT_FALSE(gone);
+  EXPECT_NE(gone.error().message().find("gone.obj"), std::string::npos) << gone.error().describe();
+  EXPECT_EQ(show.partCount(), 1u) << "a failed load leaves the show as it was";
+  EXPECT_FALSE(runControlCommand("render.prim_typ = wireframe", target));
+  EXPECT_FALSE(runControlCommand("draw\ndraw", target));
+  EXPECT_FALSE(runControlCommand("  ", target));
+  EXPECT_FALSE(runControlCommand("load_texture pic.png", target)) << "no renderer to give it to";
 }
 
 TEST(ShowDirector, OutsideOpeningHoursTheDisplayGoesDark) {

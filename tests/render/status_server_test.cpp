@@ -197,8 +197,14 @@ TEST_F(StatusServer, EachControlAnswersWhatItDid) {
   const auto reload = show_->post("/control/reload", "", bearer);
   EXPECT_EQ(reload.status, 202) << reload.body;
   const auto command = show_->post("/control/command", "render.prim_type = wireframe", bearer);
-  EXPECT_EQ(command.status, 501) << command.body;
-  EXPECT_NE(command.body.find("no LAVA script interpreter"), std::string::npos) << command.body;
+  EXPECT_EQ(command.status, 200) << command.body;
+  EXPECT_NE(command.body.find("ran: render.prim_type = wireframe"), std::string::npos) << command.body;
+  const auto typo = show_->post("/control/command", "render.prim_type = wirefram", bearer);
+  EXPECT_EQ(typo.status, 400) << typo.body;
+  EXPECT_NE(typo.body.find("wirefram"), std::string::npos) << "the reason names what is wrong: " << typo.body;
+  const auto gone = show_->post("/control/command", "load_object gone.obj", bearer);
+  EXPECT_EQ(gone.status, 400) << gone.body;
+  EXPECT_NE(gone.body.find("gone.obj"), std::string::npos) << gone.body;
   EXPECT_EQ(show_->post("/control/command", "", bearer).status, 400);
   EXPECT_EQ(show_->post("/control/command", "draw\ndraw", bearer).status, 400);
   const auto dials = show_->post("/control/restart-device?device=dials", "", bearer);
