@@ -17,7 +17,8 @@ namespace {
 // One line per command; each command lives in its own file.
 constexpr CommandSpec kCommands[] = {
     {"run", "play a show (the default show when none is given)", runUsage, runMain},
-    {"check", "find every error in a show's files (show.toml, LAVA scripts) without running them", checkUsage, checkMain},
+    {"check", "find every error in a show's files (show.toml, LAVA scripts) without running them", checkUsage,
+     checkMain},
     {"devices", "list dial boxes, cameras and capture cards, and why one cannot be used", devicesUsage, devicesMain},
     {"record", "record live devices into a trace folder for replay", recordUsage, recordMain},
 };

@@ -41,8 +41,8 @@ struct RunOptions {
   std::filesystem::path outputDir = "out";        ///< default folder for snapshots
   double fps = 60;
   ClockMode clock = ClockMode::kAuto;
-  std::optional<std::filesystem::path> saveImage;  ///< a script's bare save_image writes this
-  std::optional<std::filesystem::path> saveModel;  ///< write the show as .mdl at the end
+  std::optional<std::filesystem::path> saveImage;                     ///< a script's bare save_image writes this
+  std::optional<std::filesystem::path> saveModel;                     ///< write the show as .mdl at the end
   std::vector<std::pair<std::string, std::filesystem::path>> movies;  ///< --movie PART=FILE, in order
   std::vector<std::pair<std::string, ZoomSpec>> zooms;                ///< --zoom PART[=SCALE][@X,Y]
   bool movieOnce = false;                                             ///< --movie-once: no repeat
@@ -50,8 +50,8 @@ struct RunOptions {
   std::optional<std::filesystem::path> record;                        ///< --record PATH
   std::string recordCodec = "auto";                                   ///< --record-codec
   std::optional<std::int64_t> recordFrames;                           ///< --record-frames N
-  std::optional<std::filesystem::path> replay;  ///< a trace folder or hid-recorder file to replay
-  bool replayOnce = false;                      ///< play it once instead of looping
+  std::optional<std::filesystem::path> replay;                        ///< a trace folder or hid-recorder file to replay
+  bool replayOnce = false;                                            ///< play it once instead of looping
 };
 
 /// \brief Parses the arguments after `run`.

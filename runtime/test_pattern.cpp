@@ -191,8 +191,10 @@ Rgb8 samplePixel(const Frame& frame, std::uint32_t x, std::uint32_t y) {
   const auto& p0 = frame.planes[0];
   const std::uint8_t* row = p0.data + std::size_t{y} * p0.stride;
   switch (frame.format) {
-    case PixelFormat::kRgba8: return {row[std::size_t{x} * 4], row[std::size_t{x} * 4 + 1], row[std::size_t{x} * 4 + 2]};
-    case PixelFormat::kBgra8: return {row[std::size_t{x} * 4 + 2], row[std::size_t{x} * 4 + 1], row[std::size_t{x} * 4]};
+    case PixelFormat::kRgba8:
+      return {row[std::size_t{x} * 4], row[std::size_t{x} * 4 + 1], row[std::size_t{x} * 4 + 2]};
+    case PixelFormat::kBgra8:
+      return {row[std::size_t{x} * 4 + 2], row[std::size_t{x} * 4 + 1], row[std::size_t{x} * 4]};
     case PixelFormat::kRgb8: return {row[std::size_t{x} * 3], row[std::size_t{x} * 3 + 1], row[std::size_t{x} * 3 + 2]};
     case PixelFormat::kYuyv: {
       const std::uint8_t l = row[std::size_t{x} * 2];

@@ -312,7 +312,8 @@ std::int64_t extractElement(const ReportField& field, std::uint32_t index, std::
   std::uint64_t raw = 0;
   for (std::uint32_t b = 0; b < field.bitSize; ++b) {
     const std::uint64_t bit = start + b;
-    if ((static_cast<unsigned>(data[static_cast<std::size_t>(bit / 8)]) >> (bit % 8)) & 1u) raw |= std::uint64_t{1} << b;
+    if ((static_cast<unsigned>(data[static_cast<std::size_t>(bit / 8)]) >> (bit % 8)) & 1u)
+      raw |= std::uint64_t{1} << b;
   }
   if (field.isSigned() && field.bitSize < 64 && (raw >> (field.bitSize - 1)) & 1u) {
     return static_cast<std::int64_t>(raw) - (std::int64_t{1} << field.bitSize);

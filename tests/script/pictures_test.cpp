@@ -123,7 +123,6 @@ TEST_F(Pictures, SaveModelGivesTheSamePictureBitForBit) {
   }
 }
 
-
 TEST_F(Pictures, LoadObjectShowsAModelWithItsMaterials) {
   // The Cornell box from the shared test data (tinyobjloader's), beside its material library.
   const auto source = basalt::test::testdataDir() / "models/obj/tinyobjloader";

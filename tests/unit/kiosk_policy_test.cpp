@@ -129,7 +129,8 @@ TEST(KioskPolicy, OpeningFollowsLocalTimeAcrossTheChangeToSummerTime) {
   const Manifest m = museum();
   const Schedule s = scheduleOf(m);
   const auto at = [](int d, int h, int min) {
-    return WallTime{seconds(daysFromCivil(2026, 3, static_cast<unsigned>(d)) * 86400 + std::int64_t{h} * 3600 + std::int64_t{min} * 60)};
+    return WallTime{seconds(daysFromCivil(2026, 3, static_cast<unsigned>(d)) * 86400 + std::int64_t{h} * 3600 +
+                            std::int64_t{min} * 60)};
   };
   EXPECT_FALSE(s.isOpen(at(28, 8, 59)));
   EXPECT_TRUE(s.isOpen(at(28, 9, 0))) << "Saturday 10:00 CET is 09:00 UTC";

@@ -17,7 +17,8 @@ namespace basalt::kiosk {
 namespace {
 
 WallTime utc(int y, unsigned m, unsigned d, int hour, int minute = 0) {
-  return WallTime{std::chrono::seconds(daysFromCivil(y, m, d) * 86400 + std::int64_t{hour} * 3600 + std::int64_t{minute} * 60)};
+  return WallTime{
+      std::chrono::seconds(daysFromCivil(y, m, d) * 86400 + std::int64_t{hour} * 3600 + std::int64_t{minute} * 60)};
 }
 
 TEST(TimeZone, CivilDaysRoundTrip) {
