@@ -25,6 +25,7 @@
 #include "kiosk/state_store.h"
 #include "kiosk/status_board.h"
 #include "kiosk/status_server.h"
+#include "kiosk/stream_factories.h"
 #include "kiosk/supervisor.h"
 #include "media/image_io.h"
 #include "render/output.h"
@@ -199,9 +200,8 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
   for (const ParsedOption& o : *parsed) {
     if (o.name.empty()) {
       if (run.manifest || run.show) {
-        return fail(Errc::kInvalidArgument,
-                    fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
-                                (run.manifest ? *run.manifest : *run.show).string()));
+        return fail(Errc::kInvalidArgument, fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
+                                                        (run.manifest ? *run.manifest : *run.show).string()));
       }
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
       if (o.value.ends_with(".toml")) {
@@ -506,6 +506,7 @@ int runShow(const RunOptions& options) {
   }
 
   // Texture images are read in the background: the first frame does not wait for them.
+  registerShowFactories();  // hid and replay dial boxes, movie and camera streams
   auto loaded = loadShow(manifest, clock, false);
   if (!loaded) return failWith(loaded.error(), "cannot load the show");
 
@@ -541,6 +542,7 @@ int runShow(const RunOptions& options) {
   std::optional<ScriptPlayer> player;
   if (script) {
     ScriptPlayerOptions playerOptions;
+    setScriptVcrOptions(playerOptions, manifest, clock);
     playerOptions.outputDir = options.outputDir;
     if (options.saveImage) playerOptions.saveImage = *options.saveImage;
     player.emplace(std::move(*script), show, **renderer, std::move(playerOptions));

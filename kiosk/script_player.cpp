@@ -3,8 +3,7 @@
 //
 // Limits of this build, each reported to the script's author once, never silently:
 // - load_object: the OBJ/OFF loaders are not in this build yet; load_color_cube works.
-// - tv.*: no movie player or camera backend yet; the commands are read and answered
-//   "not available".
+// - tv.camera: only where the show names a camera in its manifest; otherwise the script is told.
 // - save_image writes Sun rasterfiles (ras.im32) once media::writeImage can; until then the
 //   picture is written as PNG beside the requested name, and the author is told.
 
@@ -20,7 +19,9 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "kiosk/stream_factories.h"
 #include "media/image_io.h"
+#include "render/stream_texture.h"
 #include "runtime/formats/model.h"
 #include "runtime/log.h"
 
@@ -133,7 +134,7 @@ void ScriptPlayer::runStep() {
 }
 
 Result<void> ScriptPlayer::beforeDraw(const FrameContext& frame) {
-  (void)frame;
+  updateVideo(frame.time, options_.manualClock);
   if (!started_) {
     // Frame 0 shows what the script set up to its first draw.
     started_ = true;
@@ -191,8 +192,10 @@ Result<void> ScriptPlayer::loadObject(const std::filesystem::path& file, runtime
     for (const std::string* name : {&part.texture, &part.reflectionTexture}) {
       if (name->empty() || renderer_.textures().find(*name) != nullptr) continue;
       auto image = media::readImage(*name);
-      auto uploaded = image ? renderer_.textures().setImage(*name, *image) : Result<void>(std::unexpected(image.error()));
-      if (!uploaded) warn(fmt::format("the texture of part '{}' is not shown: {}", part.name, uploaded.error().describe()));
+      auto uploaded =
+          image ? renderer_.textures().setImage(*name, *image) : Result<void>(std::unexpected(image.error()));
+      if (!uploaded)
+        warn(fmt::format("the texture of part '{}' is not shown: {}", part.name, uploaded.error().describe()));
     }
   }
   return {};
@@ -251,11 +254,106 @@ Result<void> ScriptPlayer::accumulateJitterPass(int pass, int passes) {
 
 Result<void> ScriptPlayer::tv(const script::TvRequest& request) {
   if (request.op == script::TvOp::kCamera) {
-    return fail(Errc::kUnavailable,
-                "cameras are not available to scripts in this build yet; the show goes on without the camera");
+    if (!request.on) {
+      camera_.reset();
+      return {};
+    }
+    if (camera_) return {};
+    if (!options_.camera) {
+      return fail(Errc::kUnavailable,
+                  "this show has no camera: name one in the show manifest's [devices] (kind = \"camera\") and "
+                  "play the script from it; the show goes on without the camera");
+    }
+    auto camera = options_.camera();
+    if (!camera) return std::unexpected(camera.error());
+    camera_ = std::move(*camera);
+    return {};
   }
-  return fail(Errc::kUnavailable,
-              "the movie player is not available to scripts in this build yet; the show goes on without the movie");
+  return vcrCommand(request);
+}
+
+Result<void> ScriptPlayer::vcrCommand(const script::TvRequest& request) {
+  using script::TvOp;
+  if (request.op == TvOp::kMovie) {
+    if (!vcr_) {
+      media::MoviePlayerOptions options;
+      options.name = "the script's movie";
+      auto player = media::MoviePlayer::create(options);
+      if (!player) return std::unexpected(player.error());
+      vcr_ = std::move(*player);
+    }
+    if (auto r = vcr_->load(request.file); !r) {
+      vcr_->unload();
+      return r;
+    }
+    return {};
+  }
+  if (!vcr_ || vcr_->state() == media::MovieState::kEmpty) {
+    if (request.op == TvOp::kUnload || request.op == TvOp::kStop) return {};
+    return fail(Errc::kUnavailable, "no movie is loaded; load one first with tv.movie = \"FILE\"");
+  }
+  if (vcr_->state() == media::MovieState::kFailed) {
+    const auto error = vcr_->error();
+    if (request.op != TvOp::kUnload) {
+      return fail(Errc::kUnavailable,
+                  fmt::format("the movie cannot play ({})", error ? error->message() : std::string("decoding failed")));
+    }
+  }
+  switch (request.op) {
+    case TvOp::kUnload: vcr_->unload(); break;
+    case TvOp::kPlay: vcr_->play(); break;
+    case TvOp::kPause: vcr_->pause(); break;
+    case TvOp::kStop: vcr_->stop(); break;
+    case TvOp::kStepForward: vcr_->stepForward(); break;
+    case TvOp::kStepReverse: vcr_->stepBack(); break;
+    case TvOp::kRewind: vcr_->rewind(); break;
+    case TvOp::kFastForward: vcr_->fastForward(10); break;
+    case TvOp::kShuttle:
+      if (request.frames >= 0) {
+        vcr_->fastForward(request.frames);
+      } else {
+        vcr_->seekFrame(std::max<std::int64_t>(0, std::max<std::int64_t>(vcr_->currentFrame(), 0) + request.frames));
+      }
+      break;
+    case TvOp::kRepeat: vcr_->setRepeat(request.on); break;
+    case TvOp::kMovie:
+    case TvOp::kCamera: break;
+  }
+  return {};
+}
+
+void ScriptPlayer::updateVideo(Nanos showTime, bool manualClock) {
+  const std::string name(kScriptVideoTexture);
+  bool live = false;
+  if (camera_) {
+    // The live camera wins over the movie while it is on (LAVA: one video input at a time).
+    live = camera_->update(showTime, renderer_.textures(), name);
+  } else if (vcr_ && vcr_->state() != media::MovieState::kEmpty && vcr_->state() != media::MovieState::kFailed) {
+    if (!video_) {
+      auto texture = render::StreamTexture::create(name);
+      if (!texture) {
+        warn(fmt::format("the movie cannot be shown: {}", texture.error().describe()));
+        vcr_->unload();
+        return;
+      }
+      video_ = std::move(*texture);
+    }
+    if (manualClock) vcr_->waitForFrameDue(showTime, std::chrono::seconds(10));
+    const FrameRef frame = vcr_->frameAt(showTime);
+    auto changed = video_->update(frame);
+    if (!changed) {
+      warn(fmt::format("the movie cannot be shown: {}; it is unloaded", changed.error().describe()));
+      vcr_->unload();
+    } else if (!video_->showingFallback()) {
+      video_->publish(renderer_.textures());
+      live = true;
+    }
+  }
+  if (!live && videoLive_) {
+    renderer_.textures().remove(name);
+    if (video_) video_->showFallback();  // a movie loaded next never shows this one's frame
+  }
+  videoLive_ = live;
 }
 
 bool ScriptPlayer::renders(Feature feature) const {
