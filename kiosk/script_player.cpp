@@ -113,6 +113,10 @@ ScriptPlayer::ScriptPlayer(script::Interpreter interpreter, runtime::Show& show,
                            ScriptPlayerOptions options)
     : interpreter_(std::move(interpreter)), show_(show), renderer_(renderer), options_(std::move(options)) {}
 
+ScriptPlayer::~ScriptPlayer() {
+  if (videoLive_) renderer_.textures().remove(kScriptVideoTexture);
+}
+
 void ScriptPlayer::setReporter(const script::Interpreter::Reporter& reporter) {
   reporter_ = reporter;
   interpreter_.setReporter(reporter);

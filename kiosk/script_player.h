@@ -21,6 +21,7 @@
 #include "kiosk/show_loader.h"
 #include "media/movie_player.h"
 #include "render/renderer.h"
+#include "render/stream_texture.h"
 #include "runtime/image.h"
 #include "runtime/script/host.h"
 #include "runtime/script/interpreter.h"
@@ -47,6 +48,10 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
  public:
   ScriptPlayer(script::Interpreter interpreter, runtime::Show& show, render::Renderer& renderer,
                ScriptPlayerOptions options);
+  /// \brief Takes the VCR's texture out of the renderer's registry.
+  ~ScriptPlayer() override;
+  ScriptPlayer(const ScriptPlayer&) = delete;
+  ScriptPlayer& operator=(const ScriptPlayer&) = delete;
 
   /// \brief Where messages about the script go (errors, warnings, notes), one at a time.
   void setReporter(const script::Interpreter::Reporter& reporter);
