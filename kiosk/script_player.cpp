@@ -288,11 +288,13 @@ Result<void> ScriptPlayer::vcrCommand(const script::TvRequest& request) {
     }
     if (auto r = vcr_->load(request.file); !r) {
       vcr_->unload();
+      vcrLoaded_ = false;
       return r;
     }
+    vcrLoaded_ = true;
     return {};
   }
-  if (!vcr_ || vcr_->state() == media::MovieState::kEmpty) {
+  if (!vcr_ || !vcrLoaded_) {
     if (request.op == TvOp::kUnload || request.op == TvOp::kStop) return {};
     return fail(Errc::kUnavailable, "no movie is loaded; load one first with tv.movie = \"FILE\"");
   }
@@ -304,7 +306,10 @@ Result<void> ScriptPlayer::vcrCommand(const script::TvRequest& request) {
     }
   }
   switch (request.op) {
-    case TvOp::kUnload: vcr_->unload(); break;
+    case TvOp::kUnload:
+      vcr_->unload();
+      vcrLoaded_ = false;
+      break;
     case TvOp::kPlay: vcr_->play(); break;
     case TvOp::kPause: vcr_->pause(); break;
     case TvOp::kStop: vcr_->stop(); break;
@@ -332,12 +337,13 @@ void ScriptPlayer::updateVideo(Nanos showTime, bool manualClock) {
   if (camera_) {
     // The live camera wins over the movie while it is on (LAVA: one video input at a time).
     live = camera_->update(showTime, renderer_.textures(), name);
-  } else if (vcr_ && vcr_->state() != media::MovieState::kEmpty && vcr_->state() != media::MovieState::kFailed) {
+  } else if (vcr_ && vcrLoaded_ && vcr_->state() != media::MovieState::kFailed) {
     if (!video_) {
       auto texture = render::StreamTexture::create(name);
       if (!texture) {
         warn(fmt::format("the movie cannot be shown: {}", texture.error().describe()));
         vcr_->unload();
+        vcrLoaded_ = false;
         return;
       }
       video_ = std::move(*texture);
@@ -348,6 +354,7 @@ void ScriptPlayer::updateVideo(Nanos showTime, bool manualClock) {
     if (!changed) {
       warn(fmt::format("the movie cannot be shown: {}; it is unloaded", changed.error().describe()));
       vcr_->unload();
+      vcrLoaded_ = false;
     } else if (!video_->showingFallback()) {
       video_->publish(renderer_.textures());
       live = true;

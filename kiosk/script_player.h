@@ -106,6 +106,7 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
   std::vector<std::filesystem::path> written_;
   // The VCR (LAVA §7): one movie player and the live camera, shown as kScriptVideoTexture.
   std::unique_ptr<media::MoviePlayer> vcr_;
+  bool vcrLoaded_ = false;  // a movie is loaded (the player's state lags its commands)
   std::unique_ptr<TextureStream> camera_;
   std::unique_ptr<render::StreamTexture> video_;
   bool videoLive_ = false;

@@ -271,6 +271,7 @@ void ShowDirector::serviceDevices(Nanos now) {
           log::warn(kLogDirector, "device '{}' ({}): {}; retrying every {} s at most", slot.spec.name,
                     deviceBackendName(slot.spec.backend), opened.error().describe(), toSeconds(kMaxRetry));
         }
+        if (slot.message != opened.error().message()) changed = true;  // the status shows the new reason
         slot.message = opened.error().message();
         slot.nextAttempt = now + slot.backoff;
         slot.backoff = std::min(slot.backoff * 2, kMaxRetry);
@@ -305,7 +306,8 @@ void ShowDirector::applyInput(Nanos until) {
                                // A visitor touched something: wake the exhibit, and count as activity.
                                if (policy_->noteInput(now)) applyProgramme(now);
                                if (!player_) return;
-                               DeviceSlot& slot = show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
+                               DeviceSlot& slot =
+                                   show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
                                if (e.kind == EventKind::kButton) {
                                  if (e.value < 0.5 || e.index >= slot.buttons.size()) return;
                                  switch (slot.buttons[e.index]) {
