@@ -26,6 +26,7 @@
 #include "kiosk/state_store.h"
 #include "kiosk/status_board.h"
 #include "kiosk/status_server.h"
+#include "kiosk/stream_factories.h"
 #include "kiosk/supervisor.h"
 #include "media/image_io.h"
 #include "render/output.h"
@@ -507,6 +508,7 @@ int runShow(const RunOptions& options) {
   }
 
   // Texture images are read in the background: the first frame does not wait for them.
+  registerShowFactories();  // hid and replay dial boxes, movie and camera streams
   auto loaded = loadShow(manifest, clock, false);
   if (!loaded) return failWith(loaded.error(), "cannot load the show");
 
@@ -542,6 +544,7 @@ int runShow(const RunOptions& options) {
   std::optional<ScriptPlayer> player;
   if (script) {
     ScriptPlayerOptions playerOptions;
+    setScriptVcrOptions(playerOptions, manifest, clock);
     playerOptions.outputDir = options.outputDir;
     if (options.saveImage) playerOptions.saveImage = *options.saveImage;
     player.emplace(std::move(*script), show, **renderer, std::move(playerOptions));

@@ -1,12 +1,10 @@
 // The kiosk's side of the script language: steps the interpreter in the frame loop and serves
 // its files and pictures with media/ and render/.
 //
-// Limits of this build, each reported to the script's author once, never silently:
-// - load_object: the OBJ/OFF loaders are not in this build yet; load_color_cube works.
-// - tv.*: no movie player or camera backend yet; the commands are read and answered
-//   "not available".
-// - save_image writes Sun rasterfiles (ras.im32) once media::writeImage can; until then the
-//   picture is written as PNG beside the requested name, and the author is told.
+// load_object reads models through runtime/formats (kiosk/show_host.h), save_image writes what
+// media::writeImage writes (LAVA's Sun rasterfile ras.im32 by default), and the VCR drives a
+// media::MoviePlayer shown on the video texture. A limit of this build, reported to the script's
+// author once, never silently: tv.camera works only where the show names a camera in its manifest.
 
 #include "kiosk/script_player.h"
 
@@ -21,7 +19,9 @@
 #include <fmt/std.h>
 
 #include "kiosk/show_host.h"
+#include "kiosk/stream_factories.h"
 #include "media/image_io.h"
+#include "render/stream_texture.h"
 #include "runtime/log.h"
 
 namespace basalt::kiosk {
@@ -38,11 +38,6 @@ std::string lowerExtension(const std::filesystem::path& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
-}
-
-bool isSunRasterName(const std::filesystem::path& path) {
-  const std::string ext = lowerExtension(path);
-  return ext == ".im32" || ext == ".im24" || ext == ".im8" || ext == ".ras" || ext == ".rs" || ext == ".sun";
 }
 
 }  // namespace
@@ -112,6 +107,10 @@ ScriptPlayer::ScriptPlayer(script::Interpreter interpreter, runtime::Show& show,
                            ScriptPlayerOptions options)
     : interpreter_(std::move(interpreter)), show_(show), renderer_(renderer), options_(std::move(options)) {}
 
+ScriptPlayer::~ScriptPlayer() {
+  if (videoLive_) renderer_.textures().remove(kScriptVideoTexture);
+}
+
 void ScriptPlayer::setReporter(const script::Interpreter::Reporter& reporter) {
   reporter_ = reporter;
   interpreter_.setReporter(reporter);
@@ -133,7 +132,7 @@ void ScriptPlayer::runStep() {
 }
 
 Result<void> ScriptPlayer::beforeDraw(const FrameContext& frame) {
-  (void)frame;
+  updateVideo(frame.time, options_.manualClock);
   if (!started_) {
     // Frame 0 shows what the script set up to its first draw.
     started_ = true;
@@ -195,24 +194,8 @@ Result<void> ScriptPlayer::saveImage(std::string_view name) {
   if (!picture) return std::unexpected(picture.error());
   const std::filesystem::path path =
       name.empty() ? options_.outputDir / options_.saveImage : options_.outputDir / std::filesystem::path(name);
-  auto written = media::writeImage(path, **picture);
-  if (written) {
-    written_.push_back(path);
-    return {};
-  }
-  if (!isSunRasterName(path)) return written;
-  // The Sun rasterfile writer is not in media/ yet: keep the picture, in PNG, and say so.
-  std::filesystem::path png = path;
-  png += ".png";
-  if (auto r = media::writeImage(png, **picture); !r) return r;
-  written_.push_back(png);
-  if (!sunRasterWarned_) {
-    sunRasterWarned_ = true;
-    warn(
-        fmt::format("save_image: this build cannot write Sun rasterfiles ({}) yet; the picture went to {} "
-                    "as PNG",
-                    path.filename().string(), png.string()));
-  }
+  if (auto r = media::writeImage(path, **picture); !r) return r;
+  written_.push_back(path);
   return {};
 }
 
@@ -237,11 +220,113 @@ Result<void> ScriptPlayer::accumulateJitterPass(int pass, int passes) {
 
 Result<void> ScriptPlayer::tv(const script::TvRequest& request) {
   if (request.op == script::TvOp::kCamera) {
-    return fail(Errc::kUnavailable,
-                "cameras are not available to scripts in this build yet; the show goes on without the camera");
+    if (!request.on) {
+      camera_.reset();
+      return {};
+    }
+    if (camera_) return {};
+    if (!options_.camera) {
+      return fail(Errc::kUnavailable,
+                  "this show has no camera: name one in the show manifest's [devices] (kind = \"camera\") and "
+                  "play the script from it; the show goes on without the camera");
+    }
+    auto camera = options_.camera();
+    if (!camera) return std::unexpected(camera.error());
+    camera_ = std::move(*camera);
+    return {};
   }
-  return fail(Errc::kUnavailable,
-              "the movie player is not available to scripts in this build yet; the show goes on without the movie");
+  return vcrCommand(request);
+}
+
+Result<void> ScriptPlayer::vcrCommand(const script::TvRequest& request) {
+  using script::TvOp;
+  if (request.op == TvOp::kMovie) {
+    if (!vcr_) {
+      media::MoviePlayerOptions options;
+      options.name = "the script's movie";
+      auto player = media::MoviePlayer::create(options);
+      if (!player) return std::unexpected(player.error());
+      vcr_ = std::move(*player);
+    }
+    if (auto r = vcr_->load(request.file); !r) {
+      vcr_->unload();
+      vcrLoaded_ = false;
+      return r;
+    }
+    vcrLoaded_ = true;
+    return {};
+  }
+  if (!vcr_ || !vcrLoaded_) {
+    if (request.op == TvOp::kUnload || request.op == TvOp::kStop) return {};
+    return fail(Errc::kUnavailable, "no movie is loaded; load one first with tv.movie = \"FILE\"");
+  }
+  if (vcr_->state() == media::MovieState::kFailed) {
+    const auto error = vcr_->error();
+    if (request.op != TvOp::kUnload) {
+      return fail(Errc::kUnavailable,
+                  fmt::format("the movie cannot play ({})", error ? error->message() : std::string("decoding failed")));
+    }
+  }
+  switch (request.op) {
+    case TvOp::kUnload:
+      vcr_->unload();
+      vcrLoaded_ = false;
+      break;
+    case TvOp::kPlay: vcr_->play(); break;
+    case TvOp::kPause: vcr_->pause(); break;
+    case TvOp::kStop: vcr_->stop(); break;
+    case TvOp::kStepForward: vcr_->stepForward(); break;
+    case TvOp::kStepReverse: vcr_->stepBack(); break;
+    case TvOp::kRewind: vcr_->rewind(); break;
+    case TvOp::kFastForward: vcr_->fastForward(10); break;
+    case TvOp::kShuttle:
+      if (request.frames >= 0) {
+        vcr_->fastForward(request.frames);
+      } else {
+        vcr_->seekFrame(std::max<std::int64_t>(0, std::max<std::int64_t>(vcr_->currentFrame(), 0) + request.frames));
+      }
+      break;
+    case TvOp::kRepeat: vcr_->setRepeat(request.on); break;
+    case TvOp::kMovie:
+    case TvOp::kCamera: break;
+  }
+  return {};
+}
+
+void ScriptPlayer::updateVideo(Nanos showTime, bool manualClock) {
+  const std::string name(kScriptVideoTexture);
+  bool live = false;
+  if (camera_) {
+    // The live camera wins over the movie while it is on (LAVA: one video input at a time).
+    live = camera_->update(showTime, renderer_.textures(), name);
+  } else if (vcr_ && vcrLoaded_ && vcr_->state() != media::MovieState::kFailed) {
+    if (!video_) {
+      auto texture = render::StreamTexture::create(name);
+      if (!texture) {
+        warn(fmt::format("the movie cannot be shown: {}", texture.error().describe()));
+        vcr_->unload();
+        vcrLoaded_ = false;
+        return;
+      }
+      video_ = std::move(*texture);
+    }
+    if (manualClock) vcr_->waitForFrameDue(showTime, std::chrono::seconds(10));
+    const FrameRef frame = vcr_->frameAt(showTime);
+    auto changed = video_->update(frame);
+    if (!changed) {
+      warn(fmt::format("the movie cannot be shown: {}; it is unloaded", changed.error().describe()));
+      vcr_->unload();
+      vcrLoaded_ = false;
+    } else if (!video_->showingFallback()) {
+      video_->publish(renderer_.textures());
+      live = true;
+    }
+  }
+  if (!live && videoLive_) {
+    renderer_.textures().remove(name);
+    if (video_) video_->showFallback();  // a movie loaded next never shows this one's frame
+  }
+  videoLive_ = live;
 }
 
 bool ScriptPlayer::renders(Feature feature) const { return rendererDraws(feature); }

@@ -13,11 +13,15 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "kiosk/frame_loop.h"
+#include "kiosk/show_loader.h"
+#include "media/movie_player.h"
 #include "render/renderer.h"
+#include "render/stream_texture.h"
 #include "runtime/image.h"
 #include "runtime/script/host.h"
 #include "runtime/script/interpreter.h"
@@ -29,6 +33,11 @@ struct ScriptPlayerOptions {
   /// The file of a bare `save_image`; relative names are in outputDir. LAVA's was "ras.im32".
   std::filesystem::path saveImage = "ras.im32";
   bool quitEndsRun = true;  ///< `quit` ends the run (the script was given on the command line)
+  /// Opens the show's camera for `tv.camera = on` (kiosk/stream_factories.h scriptCamera());
+  /// empty when the show has none, and the script is told so.
+  std::function<Result<std::unique_ptr<TextureStream>>()> camera;
+  /// An offline run on a ManualClock: the VCR waits for each frame due, so that runs repeat.
+  bool manualClock = false;
 };
 
 /// \brief Runs one script against the Show of a frame loop.
@@ -39,6 +48,10 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
  public:
   ScriptPlayer(script::Interpreter interpreter, runtime::Show& show, render::Renderer& renderer,
                ScriptPlayerOptions options);
+  /// \brief Takes the VCR's texture out of the renderer's registry.
+  ~ScriptPlayer() override;
+  ScriptPlayer(const ScriptPlayer&) = delete;
+  ScriptPlayer& operator=(const ScriptPlayer&) = delete;
 
   /// \brief Where messages about the script go (errors, warnings, notes), one at a time.
   void setReporter(const script::Interpreter::Reporter& reporter);
@@ -62,11 +75,17 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
   [[nodiscard]] const std::vector<std::filesystem::path>& imagesWritten() const { return written_; }
   /// \brief How the frame being made is drawn: the step that ended it.
   [[nodiscard]] const script::StepResult& currentStep() const { return step_; }
+  /// \brief The VCR's movie player (null before the first tv.movie).
+  [[nodiscard]] const media::MoviePlayer* vcr() const { return vcr_.get(); }
+  /// \brief Whether the VCR's texture (kScriptVideoTexture) shows a movie or camera frame now.
+  [[nodiscard]] bool videoLive() const { return videoLive_; }
 
  private:
   void runStep();
   Result<const Image*> currentPicture();
   void warn(std::string message);
+  Result<void> vcrCommand(const script::TvRequest& request);
+  void updateVideo(Nanos showTime, bool manualClock);
 
   script::Interpreter interpreter_;
   runtime::Show& show_;
@@ -83,8 +102,13 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
   std::vector<std::uint32_t> jitterSum_;  // per channel, sized on the first pass
   Image jitterAverage_;
   bool jitterReady_ = false;  // jitterAverage_ is the current picture (until the next draw)
-  bool sunRasterWarned_ = false;
   std::vector<std::filesystem::path> written_;
+  // The VCR (LAVA §7): one movie player and the live camera, shown as kScriptVideoTexture.
+  std::unique_ptr<media::MoviePlayer> vcr_;
+  bool vcrLoaded_ = false;  // a movie is loaded (the player's state lags its commands)
+  std::unique_ptr<TextureStream> camera_;
+  std::unique_ptr<render::StreamTexture> video_;
+  bool videoLive_ = false;
 };
 
 /// \brief Whether `path` names a LAVA script (.mdl, any case).

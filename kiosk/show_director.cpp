@@ -273,6 +273,7 @@ void ShowDirector::serviceDevices(Nanos now) {
           log::warn(kLogDirector, "device '{}' ({}): {}; retrying every {} s at most", slot.spec.name,
                     deviceBackendName(slot.spec.backend), opened.error().describe(), toSeconds(kMaxRetry));
         }
+        if (slot.message != opened.error().message()) changed = true;  // the status shows the new reason
         slot.message = opened.error().message();
         slot.nextAttempt = now + slot.backoff;
         slot.backoff = std::min(slot.backoff * 2, kMaxRetry);

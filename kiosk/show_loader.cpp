@@ -119,7 +119,15 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
       }
       if (!bound) slot.dials = runtime::Bindings::lavaDefaults();
     } else {
-      slot.unavailable = fmt::format("this build has no {} camera backend", deviceBackendName(spec.backend));
+      // A camera is opened and kept by the texture stream of the media that shows it (its own
+      // DeviceManager); its slot only names it in the status.
+      StreamFactory cameras;
+      {
+        std::lock_guard lock(factories().mutex);
+        cameras = factories().streams[static_cast<std::size_t>(MediaKind::kCamera)];
+      }
+      slot.unavailable = cameras ? fmt::format("a camera: its state is on the stream of the media that shows it")
+                                 : fmt::format("this build has no {} camera backend", deviceBackendName(spec.backend));
     }
     slot.message = slot.unavailable;
     show->devices.push_back(std::move(slot));

@@ -348,7 +348,10 @@ struct Renderer::Impl {
     key.twoSided = faceDist && style.render.faceCulling != FaceCulling::kBack;
 
     const bool texturing = show.texture().source != runtime::TextureSource::kOff;
-    const TextureView* colorMap = texturing ? texture(d.part->texture, "texture", d.part->name) : nullptr;
+    const TextureView* video =
+        show.texture().source == runtime::TextureSource::kVideo ? self.textures_.find(kVideoTexture) : nullptr;
+    const TextureView* colorMap =
+        video ? video : (texturing ? texture(d.part->texture, "texture", d.part->name) : nullptr);
     const TextureView* reflection =
         texturing ? texture(d.part->reflectionTexture, "reflection map", d.part->name) : nullptr;
     const bool patternFill = front.fillStyle == runtime::FillStyle::kPattern;

@@ -75,15 +75,20 @@ quit
   EXPECT_GT(d.pixelsOverTolerance, 0u);
   EXPECT_LT(d.pixelsOverTolerance, first.width * first.height / 10) << "only the edges change";
 
-  // A bare save_image: LAVA's ras.im32, in the output folder (as PNG beside it until media/
-  // writes Sun rasterfiles, and the author is told so).
+  // A bare save_image: LAVA's ras.im32, a Sun rasterfile in the output folder, holding the
+  // frame drawn last (the single pass).
   const auto& last = played.imagesWritten.back();
-  EXPECT_EQ(last.parent_path(), dir_ / "out");
-  EXPECT_EQ(last.filename().string().rfind("ras.im32", 0), 0u) << last;
-  EXPECT_TRUE(std::filesystem::exists(last));
-  if (last.extension() == ".png") {
-    EXPECT_EQ(played.count(Severity::kWarning, "Sun rasterfiles"), 1u);
-  }
+  EXPECT_EQ(last, dir_ / "out" / "ras.im32");
+  std::ifstream raster(last, std::ios::binary);
+  unsigned char magic[4] = {};
+  raster.read(reinterpret_cast<char*>(magic), 4);
+  EXPECT_EQ(magic[0], 0x59);  // the Sun rasterfile magic number 0x59a66a95, big-endian
+  EXPECT_EQ(magic[1], 0xa6);
+  EXPECT_EQ(magic[2], 0x6a);
+  EXPECT_EQ(magic[3], 0x95);
+  auto reread = media::readImage(last);
+  ASSERT_TRUE(reread) << reread.error().describe();
+  EXPECT_EQ(compareImages(*reread, *single, 0).pixelsOverTolerance, 0u) << "ras.im32 is the last frame drawn";
 }
 
 TEST_F(Pictures, SaveImageBeforeAnyDrawIsReported) {

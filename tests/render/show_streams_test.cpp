@@ -1,0 +1,329 @@
+// Devices, cameras and movies from show manifests, headless on a ManualClock with the factories
+// of kiosk/stream_factories.h registered as `basalt run` registers them: the video-wall example
+// plays its movie on its texture; the camera-sculpture example, with its V4L2 camera swapped for
+// the synthetic one (no V4L2 device exists here, and the test says so) and its PowerMate for a
+// replayed recording, shows the live camera; a replayed dial box turns the show through its
+// binding; a dial box that is not plugged in shows in the status with its reason and the show
+// goes on; the scripts' VCR loads, plays, pauses, steps and rewinds a real clip from
+// ../shared/testdata/video.
+// Example failures: a factory that is never registered (streams stay "absent"); a movie texture
+// that stays on its fallback; a replayed knob whose events never reach the bindings; a missing
+// device that crashes the show or is reported without its reason; a VCR command that is ignored.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "kiosk/frame_loop.h"
+#include "kiosk/manifest.h"
+#include "kiosk/script_player.h"
+#include "kiosk/show_director.h"
+#include "kiosk/show_loader.h"
+#include "kiosk/status_board.h"
+#include "kiosk/stream_factories.h"
+#include "render/output.h"
+#include "render/renderer.h"
+#include "runtime/event_loop.h"
+#include "runtime/script/interpreter.h"
+#include "sim/providers.h"
+#include "sim/trace.h"
+#include "support/test_paths.h"
+
+namespace basalt::kiosk {
+namespace {
+
+using namespace std::chrono_literals;
+
+/// A manifest's show run headless on a ManualClock by the director.
+class Harness {
+ public:
+  explicit Harness(const std::string& name)
+      : dir_(test::scratchDir("streams-" + name)),
+        clock_(Nanos{0}, WallTime{std::chrono::hours(24 * 20000)}),
+        board_(WallTime{std::chrono::hours(24 * 20000)}, 30) {
+    registerShowFactories();
+  }
+
+  bool open(std::string& why) {
+    auto output = render::createHeadlessOutput({64, 64});
+    if (!output) {
+      why = output.error().describe();
+      return false;
+    }
+    output_ = std::move(*output);
+    renderer_ = std::move(*render::Renderer::create());
+    loop_ = std::move(*runtime::EventLoop::create(clock_));
+    return true;
+  }
+
+  [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
+
+  ::testing::AssertionResult install(const std::filesystem::path& manifest) {
+    Diagnostics d;
+    auto m = readManifest(manifest, d);
+    if (!m) return ::testing::AssertionFailure() << d.format();
+    auto loaded = loadShow(std::move(*m), clock_);
+    if (!loaded) return ::testing::AssertionFailure() << loaded.error().describe();
+    director_ = std::make_unique<ShowDirector>(
+        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30});
+    director_->install(std::move(*loaded), clock_.now(), std::nullopt);
+    return ::testing::AssertionSuccess();
+  }
+
+  void run(std::int64_t frames) {
+    FrameLoop loop({30, frames}, clock_, &clock_, *loop_, show_, *output_, *renderer_);
+    loop.addParticipant(*director_);
+    auto stats = loop.run();
+    ASSERT_TRUE(stats) << stats.error().describe();
+  }
+
+  [[nodiscard]] const LoadedTexture* texture(const std::string& name) const {
+    for (const LoadedTexture& t : director_->loaded()->textures) {
+      if (t.name == name) return &t;
+    }
+    return nullptr;
+  }
+  [[nodiscard]] const DeviceSlot* device(const std::string& name) const {
+    for (const DeviceSlot& d : director_->loaded()->devices) {
+      if (d.spec.name == name) return &d;
+    }
+    return nullptr;
+  }
+  StatusBoard& board() { return board_; }
+  runtime::Show& show() { return show_; }
+  ManualClock& clock() { return clock_; }
+
+ private:
+  std::filesystem::path dir_;
+  ManualClock clock_;
+  StatusBoard board_;
+  std::unique_ptr<render::Output> output_;
+  std::unique_ptr<render::Renderer> renderer_;
+  std::unique_ptr<runtime::EventLoop> loop_;
+  BoundedQueue<Event> events_{1024};
+  runtime::Show show_;
+  std::unique_ptr<ShowDirector> director_;
+};
+
+#define OPEN_OR_SKIP(h)                                                  \
+  do {                                                                   \
+    std::string why;                                                     \
+    if (!(h).open(why)) GTEST_SKIP() << "no headless EGL here: " << why; \
+  } while (false)
+
+std::string readText(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+bool replace(std::string& text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  if (at == std::string::npos) return false;
+  text.replace(at, from.size(), to);
+  return true;
+}
+
+/// Records a synthetic dial box that turns dial 0 by a tenth of a turn every 100 ms for 2 s
+/// into `folder` (a trace, as `basalt record` writes it).
+::testing::AssertionResult recordKnob(const std::filesystem::path& folder) {
+  ManualClock clock(Nanos{std::chrono::seconds(10)});
+  BoundedQueue<Event> events(4096);
+  devices::DeviceManager manager(clock, events);
+  sim::SyntheticProvider::Device dial;
+  dial.candidate = {sim::SyntheticDial::defaultInfo(), devices::DeviceKind::kDialBox, "", ""};
+  for (int i = 0; i < 20; ++i) dial.script.push_back({100ms * (i + 1), EventKind::kDialDelta, 0, 0.1});
+  dial.loop = false;
+  manager.addProvider(std::make_unique<sim::SyntheticProvider>(std::vector<sim::SyntheticProvider::Device>{dial}));
+  auto id = manager.request({"knob", devices::DeviceKind::kDialBox, {}, {}, {}});
+  if (!id) return ::testing::AssertionFailure() << id.error().describe();
+  auto recorder = sim::TraceRecorder::create(folder, clock, {"test-host", "basalt-test", 30, {}});
+  if (!recorder) return ::testing::AssertionFailure() << recorder.error().describe();
+  manager.setTaps(recorder->get(), nullptr);
+  manager.step(clock.now());
+  const devices::DialBox* box = manager.dialBox("knob");
+  if (!box) return ::testing::AssertionFailure() << "the synthetic knob did not open";
+  if (auto r = (*recorder)->addDialBox(*id, "knob", box->info(), box->reportDescriptor()); !r) {
+    return ::testing::AssertionFailure() << r.error().describe();
+  }
+  for (int frame = 0; frame < 75; ++frame) {
+    clock.advance(fromSeconds(1.0 / 30));
+    manager.step(clock.now());
+    Event e;
+    while (events.pop(e)) {
+    }
+  }
+  manager.setTaps(nullptr, nullptr);
+  auto info = (*recorder)->finish();
+  if (!info) return ::testing::AssertionFailure() << info.error().describe();
+  return ::testing::AssertionSuccess();
+}
+
+TEST(ShowStreams, VideoWallExamplePlaysItsMovieOnItsTexture) {
+  Harness h("video-wall");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(h.install(test::sourceDir() / "configs/shows/video-wall/show.toml"));
+  const LoadedTexture* screens = h.texture("screens.png");
+  ASSERT_NE(screens, nullptr);
+  ASSERT_NE(screens->stream, nullptr) << "no movie stream: " << screens->streamState;
+  h.run(10);
+  EXPECT_TRUE(screens->live) << screens->stream->describe();
+  EXPECT_NE(screens->stream->describe().find("loop.webm"), std::string::npos) << screens->stream->describe();
+  const StatusSnapshot s = h.board().snapshot(WallTime{});
+  ASSERT_EQ(s.streams.size(), 1u);
+  EXPECT_EQ(s.streams[0].state, "playing");
+}
+
+TEST(ShowStreams, CameraSculptureExampleShowsTheLiveCamera) {
+  // No V4L2 camera exists on a test machine: the example's camera is swapped for the synthetic
+  // one (colour bars) and its PowerMate for a replayed recording of a knob; everything else is
+  // the example's manifest.
+  Harness h("camera-sculpture");
+  OPEN_OR_SKIP(h);
+  const auto example = test::sourceDir() / "configs/shows/camera-sculpture";
+  for (const char* file : {"sculpture.sce", "sculpture.obj", "camera.png"}) {
+    std::filesystem::copy_file(example / file, h.dir() / file, std::filesystem::copy_options::overwrite_existing);
+  }
+  ASSERT_TRUE(recordKnob(h.dir() / "knob.trace"));
+  std::string manifest = readText(example / "show.toml");
+  ASSERT_TRUE(replace(manifest, "kind = \"kms\"", "kind = \"headless\""));
+  ASSERT_TRUE(replace(manifest, "connector = \"HDMI-A-1\"", ""));
+  ASSERT_TRUE(replace(manifest, "backend = \"v4l2\"\nmatch = { path = \"/dev/video0\" }", "backend = \"synthetic\""));
+  ASSERT_TRUE(replace(manifest, "backend = \"hid\"\nmatch = { usb = \"077d:0410\" }",
+                      "backend = \"replay\"\n"
+                      "trace = \"knob.trace\"\n#"));
+  std::ofstream(h.dir() / "show.toml") << manifest;
+  ASSERT_TRUE(h.install(h.dir() / "show.toml"));
+  const LoadedTexture* camera = h.texture("camera.png");
+  ASSERT_NE(camera, nullptr);
+  ASSERT_NE(camera->stream, nullptr) << "no camera stream: " << camera->streamState;
+  h.run(15);
+  EXPECT_TRUE(camera->live) << camera->stream->describe();
+  EXPECT_NE(camera->stream->describe().find("Synthetic camera"), std::string::npos) << camera->stream->describe();
+  const DeviceSlot* knob = h.device("knob");
+  ASSERT_NE(knob, nullptr);
+  EXPECT_EQ(knob->state, devices::DeviceState::kLive) << knob->message;
+}
+
+TEST(ShowStreams, AReplayedDialBoxTurnsTheShow) {
+  Harness h("replay-dial");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(recordKnob(h.dir() / "knob.trace"));
+  std::ofstream(h.dir() / "show.toml") << R"(
+[show]
+name = "Turned by a recording"
+entry = "default"
+[devices.knob]
+kind = "dial_box"
+backend = "replay"
+trace = "knob.trace"
+loop = false
+[[bindings]]
+device = "knob"
+dial = 0
+action = "rotate_y"
+gain = 180
+)";
+  ASSERT_TRUE(h.install(h.dir() / "show.toml"));
+  h.run(2);
+  const Mat4 before = h.show().position().global;
+  const DeviceSlot* knob = h.device("knob");
+  ASSERT_NE(knob, nullptr);
+  EXPECT_EQ(knob->state, devices::DeviceState::kLive) << knob->message;
+  h.run(75);
+  EXPECT_FALSE(h.show().position().global == before) << "two turns of the replayed knob did not turn the show";
+}
+
+TEST(ShowStreams, AMissingDialBoxShowsInTheStatusWithItsReason) {
+  Harness h("missing-dial");
+  OPEN_OR_SKIP(h);
+  std::ofstream(h.dir() / "show.toml") << R"(
+[show]
+name = "Waiting for a knob"
+entry = "default"
+[devices.knob]
+kind = "dial_box"
+backend = "hid"
+match = { usb = "077d:0410", serial = "no-such-serial-basalt-test" }
+)";
+  ASSERT_TRUE(h.install(h.dir() / "show.toml"));
+  h.run(5);
+  const DeviceSlot* knob = h.device("knob");
+  ASSERT_NE(knob, nullptr);
+  EXPECT_NE(knob->state, devices::DeviceState::kLive);
+  const StatusSnapshot s = h.board().snapshot(WallTime{});
+  ASSERT_EQ(s.devices.size(), 1u);
+  EXPECT_EQ(s.devices[0].name, "knob");
+  EXPECT_NE(s.devices[0].message.find("077d:0410"), std::string::npos) << s.devices[0].message;
+  EXPECT_NE(s.devices[0].message.find("plugged"), std::string::npos) << s.devices[0].message;
+}
+
+TEST(ShowStreams, TheScriptVcrDrivesARealClip) {
+  const auto clip = test::testdataDir() / "video/mpeg1/test-sample-320x240-29.970fps-14.014s.m1v";
+  if (test::testdataDir().empty() || !std::filesystem::exists(clip)) {
+    GTEST_SKIP() << "../shared/testdata/video/mpeg1 is missing";
+  }
+  Harness h("script-vcr");
+  OPEN_OR_SKIP(h);
+  const auto script = h.dir() / "vcr.mdl";
+  std::filesystem::copy_file(clip, h.dir() / "clip.m1v", std::filesystem::copy_options::overwrite_existing);
+  std::ofstream(script) << "tv.movie = \"clip.m1v\"\n"
+                        << "texture.switch = video\n"
+                        << "tv.play\n"
+                        << "draw\ndraw\ndraw\ndraw\ndraw\ndraw\ndraw\ndraw\ndraw\ndraw\n"  // frames 1-10
+                        << "tv.pause\n"
+                        << "draw\ndraw\ndraw\n"  // 11-13
+                        << "tv.step_forward\n"
+                        << "draw\ndraw\n"  // 14-15
+                        << "tv.fast_forward\n"
+                        << "draw\ndraw\n"  // 16-17
+                        << "tv.rewind\n"
+                        << "draw\ndraw\n"  // 18-19
+                        << "tv.unload\n"
+                        << "draw\nquit\n";
+  auto interpreter = script::Interpreter::load(script);
+  ASSERT_TRUE(interpreter) << interpreter.error().describe();
+  for (const script::Diagnostic& d : interpreter->program().diagnostics) ADD_FAILURE() << d.describe();
+  render::Size size{64, 64};
+  auto output = render::createHeadlessOutput(size);
+  ASSERT_TRUE(output);
+  auto renderer = render::Renderer::create();
+  ASSERT_TRUE(renderer);
+  ManualClock clock;
+  auto loop = runtime::EventLoop::create(clock);
+  ASSERT_TRUE(loop);
+  runtime::Show show = script::startupShow();
+  ScriptPlayerOptions options;
+  options.manualClock = true;
+  ScriptPlayer player(std::move(*interpreter), show, **renderer, options);
+  std::vector<std::string> errors;
+  player.setReporter([&](const script::Diagnostic& d) { errors.push_back(d.describe()); });
+
+  // Frame by frame, noting where the movie is after each.
+  std::vector<std::int64_t> at;
+  std::vector<bool> live;
+  for (int f = 0; f < 21 && !player.wantsStop(); ++f) {
+    FrameLoop frames({30, 1}, clock, &clock, **loop, show, **output, **renderer);
+    frames.addParticipant(player);
+    auto stats = frames.run();
+    ASSERT_TRUE(stats) << stats.error().describe();
+    clock.advance(fromSeconds(1.0 / 10));  // 100 ms a frame: about three movie frames
+    at.push_back(player.vcr() ? player.vcr()->currentFrame() : -2);
+    live.push_back(player.videoLive());
+  }
+  EXPECT_TRUE(errors.empty()) << errors.front();
+  ASSERT_GE(at.size(), 20u);
+  EXPECT_TRUE(live[2]) << "the movie is not on the video texture";
+  // A command after the Nth draw runs in frame N-1's afterDraw: the next frame shows it.
+  EXPECT_GT(at[9], at[2]) << "play does not move the movie on";
+  EXPECT_EQ(at[12], at[10]) << "pause does not hold the frame";
+  EXPECT_EQ(at[13], at[12] + 1) << "step_forward does not step one frame";
+  EXPECT_GE(at[15], at[13] + 10) << "fast_forward does not go ten frames on";
+  EXPECT_LE(at[17], 1) << "rewind does not go back to the start";
+  EXPECT_FALSE(live.back()) << "after unload the video texture is gone";
+}
+
+}  // namespace
+}  // namespace basalt::kiosk
