@@ -247,8 +247,11 @@ void ShowDirector::handleControls(const FrameContext& frame) {
           it->message = opened ? std::string() : opened.error().message();
           log::info(kLogDirector, "device '{}' restarted by the control server: {}", request.argument,
                     opened ? "live" : it->message);
-          reply.answer(opened ? 200 : 500,
-                       opened ? fmt::format("'{}' restarted", request.argument) : opened.error().describe());
+          // A device that is not there is not the server's fault: 503, and the director retries.
+          reply.answer(opened ? 200 : 503,
+                       opened ? fmt::format("'{}' restarted", request.argument)
+                              : fmt::format("'{}' could not be reopened: {}; it is retried every few seconds",
+                                            request.argument, opened.error().describe()));
         }
         break;
       }

@@ -95,7 +95,7 @@ TEST_F(StatusServer, HealthReportsTheShowItsFramesAndItsDevices) {
   EXPECT_NE(h.body.find("\"name\": \"knob\", \"kind\": \"dial_box\", \"backend\": \"hid\", \"state\": \"absent\""),
             std::string::npos)
       << h.body;
-  EXPECT_NE(h.body.find("this build has no hid dial box backend"), std::string::npos) << h.body;
+  EXPECT_NE(h.body.find("no hid 077d:0410 is plugged in"), std::string::npos) << "the reason: " << h.body;
   EXPECT_NE(h.body.find("\"frame_time_ms\": {\"p50\": "), std::string::npos) << h.body;
   EXPECT_EQ(h.body.find("\"frames\": {\n    \"total\": 0,"), std::string::npos) << "frames were drawn: " << h.body;
   EXPECT_NE(h.body.find("\"frames\": {\n    \"total\": "), std::string::npos) << h.body;
@@ -210,8 +210,9 @@ TEST_F(StatusServer, EachControlAnswersWhatItDid) {
   const auto dials = show_->post("/control/restart-device?device=dials", "", bearer);
   EXPECT_EQ(dials.status, 200) << dials.body;
   const auto knob = show_->post("/control/restart-device", "knob", bearer);
-  EXPECT_EQ(knob.status, 409) << knob.body;
-  EXPECT_NE(knob.body.find("cannot be restarted"), std::string::npos);
+  EXPECT_EQ(knob.status, 503) << "the knob is not plugged in: " << knob.body;
+  EXPECT_NE(knob.body.find("'knob' could not be reopened: "), std::string::npos) << knob.body;
+  EXPECT_NE(knob.body.find("077d:0410"), std::string::npos) << knob.body;
   EXPECT_EQ(show_->post("/control/restart-device?device=nope", "", bearer).status, 404);
   // The reload went through and the show is the same one.
   ::usleep(500000);
