@@ -48,7 +48,7 @@ format:
 
 sanitize: setup
 	@cmake -S . -B $(BUILD)-sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DBASALT_WERROR=ON \
-	  -DBASALT_SANITIZE=address,undefined $(CMAKE_ARGS) >/dev/null
+	  -DBASALT_SANITIZE=address,undefined -DBASALT_BENCH=OFF $(CMAKE_ARGS) >/dev/null
 	@cmake --build $(BUILD)-sanitize
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

@@ -2,6 +2,8 @@
 # through basalt_target_defaults().
 
 option(BASALT_WERROR "Treat compiler warnings as errors" OFF)
+# The sanitizer build runs no benchmark, so it need not build them (CI time).
+option(BASALT_BENCH "Build the benchmarks (tests/bench)" ON)
 set(BASALT_SANITIZE "" CACHE STRING
     "Sanitizers to build with: a comma-separated subset of address,undefined,thread")
 
