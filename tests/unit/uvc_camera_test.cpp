@@ -218,6 +218,39 @@ TEST(UvcJpeg, OddSizesArePadded) {
   EXPECT_NEAR(image->at(39, 19, 1), 200, 4);
 }
 
+// Makes sure the JPEG header reader finds size and comment in the encoder's files and refuses
+// what is not a JPEG file or is cut short. Example failure: a frame cut off inside a segment is
+// read past its end.
+TEST(UvcJpeg, HeaderReaderFindsSizeAndComment) {
+  auto picture = TestPicture::create(320, 240);
+  ASSERT_TRUE(picture);
+  Yuv422Planes planes;
+  picture->renderPlanar(7, 128, planes);
+  std::vector<std::uint8_t> jpeg;
+  JpegEncoder().encode(planes, jpeg, "basalt-vlab-uvc frame 7");
+  const auto info = inspectJpeg(jpeg);
+  ASSERT_TRUE(info);
+  EXPECT_EQ(info->width, 320U);
+  EXPECT_EQ(info->height, 240U);
+  EXPECT_TRUE(info->baseline);
+  EXPECT_TRUE(info->complete);
+  EXPECT_EQ(info->comment, "basalt-vlab-uvc frame 7");
+  EXPECT_EQ(mjpegFrameNumber(jpeg), 7U);
+  auto decoded = decodeJpeg(jpeg, "comment");
+  ASSERT_TRUE(decoded) << "a COM segment must not upset a decoder: " << decoded.error().describe();
+  EXPECT_EQ(readFrameCounterRgb(*decoded), 7U);
+
+  const auto cut = std::span<const std::uint8_t>(jpeg).first(jpeg.size() - 100);
+  ASSERT_TRUE(inspectJpeg(cut));
+  EXPECT_FALSE(inspectJpeg(cut)->complete);
+  EXPECT_FALSE(inspectJpeg(std::span<const std::uint8_t>(jpeg).first(30)));
+  EXPECT_FALSE(inspectJpeg(std::span<const std::uint8_t>(jpeg).subspan(2)));
+  std::vector<std::uint8_t> noComment;
+  JpegEncoder().encode(planes, noComment);
+  EXPECT_FALSE(mjpegFrameNumber(noComment));
+  EXPECT_EQ(noComment.size() + 4 + 23, jpeg.size());
+}
+
 // ---- payloads -------------------------------------------------------------------------------
 
 struct PayloadCase {
@@ -515,6 +548,7 @@ TEST_F(UvcCameraTest, MjpegStreamSendsDecodableFrames) {
     EXPECT_EQ(image->width, 640U);
     EXPECT_EQ(image->height, 480U);
     EXPECT_EQ(readFrameCounterRgb(*image), i);
+    EXPECT_EQ(mjpegFrameNumber(reader.frames()[i]), i) << "the COM segment agrees with the picture";
     EXPECT_LE(reader.frames()[i].size(), c.maxVideoFrameSize);
   }
   EXPECT_EQ(camera_->oversizedFrames(), 0U);

@@ -159,7 +159,7 @@ JpegEncoder::JpegEncoder(int quality) : quality_(std::clamp(quality, 1, 100)) {
   fill(kAcChromaBits, kAcChromaValues, acChroma_);
 }
 
-void JpegEncoder::encode(const Yuv422Planes& picture, std::vector<std::uint8_t>& out) const {
+void JpegEncoder::encode(const Yuv422Planes& picture, std::vector<std::uint8_t>& out, std::string_view comment) const {
   out.clear();
   const unsigned width = picture.width;
   const unsigned height = picture.height;
@@ -170,6 +170,11 @@ void JpegEncoder::encode(const Yuv422Planes& picture, std::vector<std::uint8_t>&
   marker(out, 0xe0, 16);  // APP0: JFIF 1.1, no density
   for (const char c : {'J', 'F', 'I', 'F', '\0'}) out.push_back(static_cast<std::uint8_t>(c));
   out.insert(out.end(), {1, 1, 0, 0, 1, 0, 1, 0, 0});
+  if (!comment.empty()) {
+    comment = comment.substr(0, 65533);
+    marker(out, 0xfe, static_cast<unsigned>(2 + comment.size()));  // COM
+    out.insert(out.end(), comment.begin(), comment.end());
+  }
   marker(out, 0xdb, 2 + 2 * 65);  // DQT: table 0 luma, table 1 chroma, zig-zag order
   out.push_back(0);
   for (const auto z : kZigzag) out.push_back(lumaQuant_[z]);
@@ -267,6 +272,36 @@ void JpegEncoder::encode(const Yuv422Planes& picture, std::vector<std::uint8_t>&
   bits.finish();
   out.push_back(0xff);
   out.push_back(0xd9);  // EOI
+}
+
+std::optional<JpegInfo> inspectJpeg(std::span<const std::uint8_t> jpeg) {
+  if (jpeg.size() < 4 || jpeg[0] != 0xff || jpeg[1] != 0xd8) return std::nullopt;
+  JpegInfo info;
+  info.complete = jpeg[jpeg.size() - 2] == 0xff && jpeg[jpeg.size() - 1] == 0xd9;
+  bool haveFrame = false;
+  std::size_t at = 2;
+  while (at + 4 <= jpeg.size()) {
+    if (jpeg[at] != 0xff) return std::nullopt;
+    const std::uint8_t code = jpeg[at + 1];
+    if (code == 0xff) {  // fill byte
+      ++at;
+      continue;
+    }
+    const std::size_t length = (std::size_t{jpeg[at + 2]} << 8U) | jpeg[at + 3];
+    if (length < 2 || at + 2 + length > jpeg.size()) return std::nullopt;
+    const auto body = jpeg.subspan(at + 4, length - 2);
+    if (code == 0xda) break;  // start of scan: entropy-coded data follows
+    if ((code == 0xc0 || code == 0xc1 || code == 0xc2) && !haveFrame && body.size() >= 5) {
+      info.baseline = code == 0xc0;
+      info.height = (std::uint32_t{body[1]} << 8U) | body[2];
+      info.width = (std::uint32_t{body[3]} << 8U) | body[4];
+      haveFrame = true;
+    }
+    if (code == 0xfe && info.comment.empty()) info.comment.assign(body.begin(), body.end());
+    at += 2 + length;
+  }
+  if (!haveFrame) return std::nullopt;
+  return info;
 }
 
 void expandToFullRange(Yuv422Planes& planes) {

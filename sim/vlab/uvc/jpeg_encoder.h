@@ -8,6 +8,10 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "sim/vlab/uvc/test_picture.h"
@@ -22,8 +26,9 @@ class JpegEncoder {
   explicit JpegEncoder(int quality = 85);
 
   /// \brief Replaces `out` with the JPEG file of `picture` (full-range Y'CbCr, as JFIF defines
-  /// it). Sizes that are not a multiple of the 16x8 MCU are padded by repeating the edge.
-  void encode(const Yuv422Planes& picture, std::vector<std::uint8_t>& out) const;
+  /// it), with `comment` (at most 65533 bytes) in a COM segment when it is not empty. Sizes that
+  /// are not a multiple of the 16x8 MCU are padded by repeating the edge.
+  void encode(const Yuv422Planes& picture, std::vector<std::uint8_t>& out, std::string_view comment = {}) const;
 
   [[nodiscard]] int quality() const { return quality_; }
 
@@ -42,6 +47,19 @@ class JpegEncoder {
   HuffmanTable dcChroma_{};
   HuffmanTable acChroma_{};
 };
+
+/// \brief What the headers of a JPEG file say, read without decoding it.
+struct JpegInfo {
+  std::uint32_t width = 0;  ///< from the first start-of-frame segment
+  std::uint32_t height = 0;
+  bool baseline = false;  ///< SOF0
+  std::string comment;    ///< the first COM segment
+  bool complete = false;  ///< starts with SOI and ends with EOI
+};
+
+/// \brief Reads the segments of `jpeg` up to the start of scan; nothing when it is not a JPEG
+/// file (no SOI, a segment running past the end, no start of frame).
+std::optional<JpegInfo> inspectJpeg(std::span<const std::uint8_t> jpeg);
 
 /// \brief Converts limited-range (16-235, 16-240) planes to the full range JFIF expects.
 void expandToFullRange(Yuv422Planes& planes);

@@ -17,6 +17,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "runtime/error.h"
@@ -131,6 +132,10 @@ class UvcPayloadWriter {
   std::uint32_t pts_ = 0;
 };
 
+/// \brief The frame number an MJPEG frame of the camera carries in its COM segment
+/// ("basalt-vlab-uvc frame N"), for checks that cannot afford to decode it; nothing when absent.
+std::optional<std::uint32_t> mjpegFrameNumber(std::span<const std::uint8_t> jpeg);
+
 /// \brief The camera. Threading: one thread (the transport's) uses it.
 class UvcCamera final : public UsbDevice {
  public:
@@ -140,7 +145,8 @@ class UvcCamera final : public UsbDevice {
   static constexpr std::uint8_t kProcessingUnit = 2;
   static constexpr std::uint8_t kOutputTerminal = 3;
   static constexpr std::uint8_t kStreamingEndpoint = 0x81;
-  static constexpr std::uint32_t kClockFrequency = 48'000'000;  ///< dwClockFrequency, Hz
+  static constexpr std::uint32_t kClockFrequency = 48'000'000;                 ///< dwClockFrequency, Hz
+  static constexpr std::string_view kFrameComment = "basalt-vlab-uvc frame ";  ///< + the counter
 
   /// \brief Fails with kInvalidArgument for a configuration a host could not use (no format, a
   /// format without sizes or intervals, a size the test picture cannot have, more than 32
