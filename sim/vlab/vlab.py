@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Basalt's virtual lab: a stock Debian kernel under qemu with real drivers (vivid, dummy_hcd
-with configfs HID and UVC gadgets, uhid, virtio-gpu), the host's root mounted read-only, running
-Basalt's test binaries against it.
+with configfs HID gadgets, uhid, virtio-gpu, uvcvideo with the lab's own UVC camera plugged in
+through qemu's usb-redir), the host's root mounted read-only, running Basalt's test binaries
+against it.
 
     vlab.py build [--force]            build (or find cached) the kernel and initramfs
     vlab.py run [opts] -- PROG ARGS    run one program inside the lab; its output and exit status
@@ -192,6 +193,7 @@ def build(force=False):
         deb = kernel_deb(cache)
         lab = os.path.join(cache, "lab-" + lab_key(deb))
         if os.path.isfile(os.path.join(lab, "lab.json")) and not force:
+            os.utime(os.path.join(lab, "lab.json"))  # in use: kept by prune_labs
             return lab
         if free_mb(cache) < NEEDED_MB:
             raise LabUnavailable(f"no free disk: building the lab needs about {NEEDED_MB} MB in {cache}, "
@@ -223,12 +225,23 @@ def build(force=False):
             if os.path.isdir(lab):
                 shutil.rmtree(lab)
             os.replace(out, lab)
-        # Labs of older inputs are not used again (a running qemu has its kernel in memory).
-        for old in glob.glob(os.path.join(cache, "lab-*")):
-            if old != lab:
-                shutil.rmtree(old, ignore_errors=True)
+        prune_labs(cache, lab)
         say(f"lab built in {time.monotonic() - started:.1f} s: {lab}")
         return lab
+
+
+def prune_labs(cache, keep, unused_days=3):
+    """Removes labs not used for `unused_days` (12 MB each). Labs of other inputs stay for a
+    while: checkouts of different branches share the cache, and deleting the lab another one
+    is about to boot would make each rebuild the other's."""
+    for old in glob.glob(os.path.join(cache, "lab-*")):
+        stamp = os.path.join(old, "lab.json")
+        try:
+            idle = time.time() - os.path.getmtime(stamp)
+        except OSError:
+            idle = float("inf")  # a half-built lab left by a killed build
+        if old != keep and idle > unused_days * 86400:
+            shutil.rmtree(old, ignore_errors=True)
 
 
 def closure(tree, version, root):

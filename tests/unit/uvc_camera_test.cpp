@@ -57,7 +57,7 @@ class BulkStreamReader {
     if (data.size() < asked || payloadSize_ >= maxPayload_) {
       if (!skip_ && (info_ & 0x02) != 0) {
         frames_.push_back(std::move(current_));
-        pts_list_.push_back(pts_);
+        ptsList_.push_back(pts_);
         current_.clear();
         inFrame_ = false;
       }
@@ -68,7 +68,7 @@ class BulkStreamReader {
   }
 
   [[nodiscard]] const std::vector<std::vector<std::uint8_t>>& frames() const { return frames_; }
-  [[nodiscard]] const std::vector<std::uint32_t>& pts() const { return pts_list_; }
+  [[nodiscard]] const std::vector<std::uint32_t>& pts() const { return ptsList_; }
   [[nodiscard]] const std::vector<std::string>& faults() const { return faults_; }
 
  private:
@@ -83,7 +83,7 @@ class BulkStreamReader {
   std::uint32_t pts_ = 0;
   std::vector<std::uint8_t> current_;
   std::vector<std::vector<std::uint8_t>> frames_;
-  std::vector<std::uint32_t> pts_list_;
+  std::vector<std::uint32_t> ptsList_;
   std::vector<std::string> faults_;
 };
 
@@ -370,7 +370,7 @@ TEST_F(UvcCameraTest, DescriptorsDescribeABulkUvcCamera) {
   EXPECT_EQ(dev.data[10] | (dev.data[11] << 8), 0x0002);
   const auto head = control(setup(0x80, 0x06, 0x0200, 0, 9));
   ASSERT_EQ(head.data.size(), 9U);
-  const std::size_t total = head.data[2] | (head.data[3] << 8);
+  const std::size_t total = head.data[2] | (std::size_t{head.data[3]} << 8U);
   const auto cfg = control(setup(0x80, 0x06, 0x0200, 0, 0xffff));
   ASSERT_EQ(cfg.data.size(), total);
 
@@ -414,7 +414,8 @@ TEST_F(UvcCameraTest, DescriptorsDescribeABulkUvcCamera) {
   // VC header: wTotalLength covers the header and the three entities (13 + 18 + 12 + 9).
   EXPECT_EQ(cfg.data[vcHeaderAt + 5] | (cfg.data[vcHeaderAt + 6] << 8), 52);
   // VS input header: wTotalLength runs to the endpoint descriptor (the last 7 bytes).
-  EXPECT_EQ(vsHeaderAt + (cfg.data[vsHeaderAt + 4] | (cfg.data[vsHeaderAt + 5] << 8)), cfg.data.size() - 7);
+  EXPECT_EQ(vsHeaderAt + (cfg.data[vsHeaderAt + 4] | (std::size_t{cfg.data[vsHeaderAt + 5]} << 8U)),
+            cfg.data.size() - 7);
 
   const auto product = control(setup(0x80, 0x06, 0x0302, 0x0409, 255));
   ASSERT_EQ(product.data.size(), 2 + 2 * std::string("Basalt Lab Camera").size());

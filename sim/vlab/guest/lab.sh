@@ -11,8 +11,17 @@ export PATH=/bin:/sbin:/usr/bin:/usr/sbin
 results=$BASALT_VLAB_RESULTS
 hr=/host$results
 say() { echo "basalt-vlab: $*" >/dev/console; }
-fixture_ok() { echo "ok $1 $2" >>"$hr/fixtures"; }
+# timeline: seconds since the kernel started, when each fixture was done (for boot-time figures).
+stamp() {
+  read -r _up _idle </proc/uptime
+  echo "$_up $1" >>"$hr/timeline"
+}
+fixture_ok() {
+  echo "ok $1 $2" >>"$hr/fixtures"
+  stamp "$1"
+}
 fixture_fail() {
+  stamp "$1"
   echo "fail $1 $2" >>"$hr/fixtures"
   say "fixture $1 FAILED: $2"
 }
@@ -27,6 +36,7 @@ stop() {
   stop
 }
 : >"$hr/fixtures"
+stamp start
 # lab.conf (written by the host runner): BASALT_VLAB_SRC, BASALT_VLAB_TOOLS, jobs.
 [ -f "$hr/lab.conf" ] && . "$hr/lab.conf"
 
@@ -248,18 +258,25 @@ fi
 
 # ---- udev: the host's systemd-udevd, as on a real machine --------------------------------
 # libcamera enumerates only devices udevd has processed (libudev's "is initialized" match) and
-# learns of hotplug from udevd; other programs that use libudev do too. The lab's programs run
-# in a chroot, which systemd's tools refuse to work in unless told to ignore it.
+# learns of hotplug from udevd; other programs that use libudev do too. Started once the
+# fixtures exist (started first, its start-up slows theirs down under TCG). The lab's programs
+# run in a chroot, which systemd's tools refuse to work in unless told to ignore it.
+# udevd gets the rules for devices and cameras only (permissions, /dev/v4l links): the host's
+# full set, parsed and run under TCG, would add seconds to every boot for devices no test reads.
 setenv SYSTEMD_IGNORE_CHROOT 1
-if in_host "test -x /lib/systemd/systemd-udevd"; then
-  if in_host "/lib/systemd/systemd-udevd --daemon && udevadm trigger --action=add --subsystem-match=video4linux --subsystem-match=media && udevadm settle --timeout=60" >"$hr/udev.log" 2>&1; then
-    setenv BASALT_VLAB_UDEV 1
-    fixture_ok udev "systemd-udevd runs; video4linux and media devices processed"
-  else
-    fixture_fail udev "systemd-udevd did not start or settle: $(tail -1 "$hr/udev.log")"
-  fi
-else
+udev_rules=/host/usr/lib/udev/rules.d
+mkdir -p /host/run/basalt-vlab/udev-rules
+for r in 50-udev-default.rules 60-persistent-v4l.rules; do
+  [ -f "$udev_rules/$r" ] && cp "$udev_rules/$r" /host/run/basalt-vlab/udev-rules/
+done
+[ -d "$udev_rules" ] && mount --bind /host/run/basalt-vlab/udev-rules "$udev_rules"
+if ! in_host "test -x /lib/systemd/systemd-udevd"; then
   fixture_fail udev "the host has no systemd-udevd (Debian package udev; scripts/setup.sh): libcamera sees no camera without it"
+elif in_host "/lib/systemd/systemd-udevd --daemon && udevadm trigger --settle --action=add --subsystem-match=video4linux --subsystem-match=media" >"$hr/udev.log" 2>&1; then
+  setenv BASALT_VLAB_UDEV 1
+  fixture_ok udev "systemd-udevd runs; video4linux and media devices processed"
+else
+  fixture_fail udev "systemd-udevd did not start or settle: $(tail -1 "$hr/udev.log")"
 fi
 
 setenv BASALT_VLAB_GADGET_CTL "$BASALT_VLAB_SRC/sim/vlab/guest/gadget-ctl"
@@ -267,6 +284,7 @@ if [ -n "$BASALT_VLAB_TOOLS" ] && [ -x "/host$BASALT_VLAB_TOOLS/basalt-vlab-hid-
   setenv BASALT_VLAB_HID_REPLAY "$BASALT_VLAB_TOOLS/basalt-vlab-hid-replay"
 fi
 cp "$env_file" "$hr/lab.env"
+stamp ready
 say "fixtures ready"
 : >"$hr/ready"
 

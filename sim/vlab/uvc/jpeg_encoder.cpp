@@ -76,7 +76,7 @@ class BitWriter {
   explicit BitWriter(std::vector<std::uint8_t>& out) : out_(out) {}
   void put(std::uint32_t bits, unsigned count) {
     for (unsigned i = count; i-- > 0;) {
-      acc_ = static_cast<std::uint8_t>((acc_ << 1U) | ((bits >> i) & 1U));
+      acc_ = static_cast<std::uint8_t>((static_cast<unsigned>(acc_) << 1U) | ((bits >> i) & 1U));
       if (++n_ == 8) flushByte();
     }
   }
