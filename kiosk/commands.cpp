@@ -4,7 +4,11 @@
 
 #include <fmt/format.h>
 
+#include "kiosk/check_command.h"
+#include "kiosk/devices_command.h"
+#include "kiosk/record_command.h"
 #include "kiosk/run_command.h"
+#include "runtime/script/reference.h"
 
 namespace basalt::kiosk {
 
@@ -13,6 +17,9 @@ namespace {
 // One line per command; each command lives in its own file.
 constexpr CommandSpec kCommands[] = {
     {"run", "play a show (the default show when none is given)", runUsage, runMain},
+    {"check", "find every error in a show's files (show.toml, LAVA scripts) without running them", checkUsage, checkMain},
+    {"devices", "list dial boxes, cameras and capture cards, and why one cannot be used", devicesUsage, devicesMain},
+    {"record", "record live devices into a trace folder for replay", recordUsage, recordMain},
 };
 
 constexpr std::string_view kVersion = "basalt 0.1.0";
@@ -29,6 +36,8 @@ std::string overviewHelp() {
       "Commands:\n";
   for (const CommandSpec& c : kCommands) text += fmt::format("  {:<16} {}\n", c.name, c.summary);
   text += fmt::format("  {:<16} {}\n", "help [COMMAND]", "show help for a command");
+  text +=
+      fmt::format("  {:<16} {}\n", "help script", "the LAVA script language: every command, its values and defaults");
   text +=
       "\nOptions:\n"
       "  -h, --help       this text\n"
@@ -55,6 +64,10 @@ int dispatch(std::span<const std::string_view> args) {
   if (args[0] == "help") {
     if (args.size() == 1) {
       fmt::print("{}", overviewHelp());
+      return 0;
+    }
+    if (args[1] == "script") {
+      fmt::print("{}", script::scriptReference());
       return 0;
     }
     for (const CommandSpec& c : kCommands) {

@@ -1,6 +1,9 @@
 #include "kiosk/frame_loop.h"
 
 #include <chrono>
+#include <optional>
+
+#include <fmt/format.h>
 
 #include "runtime/log.h"
 
@@ -18,19 +21,24 @@ void FrameLoop::applyInput(Nanos until) {
                       [this](Event e) {
                         if (bindings_) bindings_->apply(e, show_);
                       });
+  // Continuous input (shuttle rings held off-centre) moves the show by the time since the last frame.
+  if (bindings_ && lastInput_.count() >= 0 && until > lastInput_) bindings_->advance(until - lastInput_, show_);
+  lastInput_ = until;
 }
 
-Result<void> FrameLoop::renderFrame(const FrameContext& context) {
+Result<void> FrameLoop::renderFrame(FrameContext& context) {
   for (FrameParticipant* p : participants_) {
     if (auto r = p->beforeDraw(context); !r) return r;
   }
   if (auto r = output_.beginFrame(); !r) return r;
   const render::Size size = output_.size();
-  const float aspect = static_cast<float>(size.width) / static_cast<float>(size.height);
-  renderer_.draw(show_, runtime::computeView(show_, aspect), size);
+  renderer_.drawShow(show_, {0, 0, size.width, size.height}, [&](runtime::ViewTransforms& view) {
+    for (FrameParticipant* p : participants_) p->adjustView(context, view, size);
+  });
   for (FrameParticipant* p : participants_) {
     if (auto r = p->afterDraw(context, output_); !r) return r;
   }
+  if (!context.last && participantWantsStop()) context.last = true;
   if (hook_) {
     if (auto r = hook_(context.frame, context.last, output_); !r) return r;
   }
@@ -44,12 +52,41 @@ bool FrameLoop::participantWantsStop() const {
   return false;
 }
 
+Result<void> FrameLoop::waitForOutput() {
+  // A KMS output is not ready while its last page flip is pending; the flip's event arrives on
+  // paceFd(), which the event loop watches. A flip that never completes is a driver fault: say
+  // so rather than hang (the watchdog would restart us, without a message).
+  const SystemClock wall;
+  const Nanos giveUp = wall.now() + std::chrono::seconds(2);
+  while (!output_.readyForFrame() && !stopRequested_) {
+    if (wall.now() > giveUp) {
+      return fail(Errc::kTimeout, fmt::format("the {} output did not finish presenting within 2 s", output_.kind()));
+    }
+    if (auto r = loop_.dispatch(std::chrono::milliseconds(100)); !r) return std::unexpected(r.error());
+  }
+  return {};
+}
+
 Result<FrameLoopStats> FrameLoop::run() {
   FrameLoopStats stats;
   const SystemClock wall;
   const Nanos wallStart = wall.now();
   const Nanos start = clock_.now();
+  std::optional<runtime::EventLoop::Handle> pace;
+  if (output_.paceFd() >= 0) {
+    auto watched = loop_.watchFd(output_.paceFd(), EPOLLIN, [this](std::uint32_t) { output_.onPaceReady(); });
+    if (!watched) return std::unexpected(watched.error());
+    pace = *watched;
+  }
+  struct Unwatch {
+    runtime::EventLoop& loop;
+    std::optional<runtime::EventLoop::Handle>& handle;
+    ~Unwatch() {
+      if (handle) loop.unwatch(*handle);
+    }
+  } unwatch{loop_, pace};
   for (std::int64_t frame = 0; config_.maxFrames < 0 || frame < config_.maxFrames; ++frame) {
+    if (auto r = waitForOutput(); !r) return std::unexpected(r.error());
     const Nanos due = start + frameTime(frame, config_.fps);
     if (manual_) {
       manual_->set(due);
@@ -67,14 +104,16 @@ Result<FrameLoopStats> FrameLoop::run() {
     const bool last =
         stopRequested_ || participantWantsStop() || (config_.maxFrames >= 0 && frame + 1 == config_.maxFrames);
     applyInput(due);
-    const FrameContext context{frame, due, last};
+    FrameContext context{frame, due, last};
     if (auto r = renderFrame(context); !r) return std::unexpected(r.error());
     if (frame == 0) stats.firstFrameSeconds = toSeconds(wall.now() - wallStart);
     stats.frames = frame + 1;
     stats.showTime = due - start;
+    // LAVA's performance meter: this frame's counts, rates over real time.
+    show_.performance().recordFrame(renderer_.takeFrameCounts(), wall.now());
     show_.advanceFrame();
     for (FrameParticipant* p : participants_) p->afterPresent(context);
-    if (last) break;
+    if (context.last) break;
   }
   stats.wallSeconds = toSeconds(wall.now() - wallStart);
   return stats;

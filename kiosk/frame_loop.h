@@ -40,6 +40,13 @@ class FrameParticipant {
     (void)frame;
     return {};
   }
+  /// \brief Between computing the view and drawing: may change how this frame is seen (a
+  /// script's sub-pixel jitter). `size` is the output's size in pixels.
+  virtual void adjustView(const FrameContext& frame, runtime::ViewTransforms& view, render::Size size) {
+    (void)frame;
+    (void)view;
+    (void)size;
+  }
   /// \brief After drawing, before presenting: read-back users (snapshots, recording, tests).
   virtual Result<void> afterDraw(const FrameContext& frame, render::Output& output) {
     (void)frame;
@@ -49,7 +56,8 @@ class FrameParticipant {
   /// \brief After presenting and after the show advanced: metrics, watchdog pings.
   virtual void afterPresent(const FrameContext& frame) { (void)frame; }
   /// \brief True when this participant wants the loop to end after the current frame (a
-  /// script's `quit`, the end of a recording).
+  /// script's `quit`, the end of a recording). Asked before each frame and again after the
+  /// participants' afterDraw(), so that a frame can become the last one while it is made.
   [[nodiscard]] virtual bool wantsStop() const { return false; }
 };
 
@@ -86,7 +94,7 @@ class FrameLoop {
   /// \brief Adds a participant (borrowed: it must outlive the loop's run()).
   void addParticipant(FrameParticipant& participant) { participants_.push_back(&participant); }
   /// \brief The queue input events arrive in (owned by the caller).
-  void setEvents(BoundedQueue<Event>* events, const runtime::Bindings* bindings) {
+  void setEvents(BoundedQueue<Event>* events, runtime::Bindings* bindings) {
     events_ = events;
     bindings_ = bindings;
   }
@@ -98,7 +106,10 @@ class FrameLoop {
 
  private:
   void applyInput(Nanos until);
-  Result<void> renderFrame(const FrameContext& context);
+  /// Waits, serving the event loop, until the output can take the next frame (paced outputs).
+  Result<void> waitForOutput();
+  /// Draws one frame; `context.last` becomes true when a participant asks to stop during it.
+  Result<void> renderFrame(FrameContext& context);
   [[nodiscard]] bool participantWantsStop() const;
 
   FrameLoopConfig config_;
@@ -111,7 +122,8 @@ class FrameLoop {
   FrameHook hook_;
   std::vector<FrameParticipant*> participants_;
   BoundedQueue<Event>* events_ = nullptr;
-  const runtime::Bindings* bindings_ = nullptr;
+  runtime::Bindings* bindings_ = nullptr;  // stateful: dial speeds and shuttles
+  Nanos lastInput_{-1};
   bool stopRequested_ = false;
 };
 

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -13,17 +14,31 @@
 #include <fmt/std.h>
 
 #include "kiosk/commands.h"
+#include "kiosk/device_wiring.h"
 #include "kiosk/frame_loop.h"
+#include "kiosk/frame_metrics.h"
+#include "kiosk/manifest.h"
 #include "kiosk/options.h"
+#include "kiosk/script_player.h"
+#include "kiosk/show_director.h"
+#include "kiosk/show_loader.h"
+#include "kiosk/state_store.h"
+#include "kiosk/status_board.h"
+#include "kiosk/status_server.h"
+#include "kiosk/supervisor.h"
 #include "media/image_io.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/event_loop.h"
 #include "runtime/image.h"
 #include "runtime/log.h"
+#include "runtime/script/interpreter.h"
+#include "runtime/script/save_model.h"
 #include "runtime/show/show.h"
 
 namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Run, "kiosk");
 
 namespace {
 
@@ -72,30 +87,84 @@ Result<void> parseSize(std::string_view text, RunOptions& run) {
 }  // namespace
 
 std::string_view runUsage() {
-  return R"(Usage: basalt run [options]
+  return R"(Usage: basalt run [options] [show.toml | SCRIPT.mdl]
 
-Plays a show. With no show given it plays the default show: LAVA's start-up scene, a
-coloured cube on black, 500x500, turning slowly under LAVA's default lights. With no display
-it renders offscreen through EGL (headless) and writes a snapshot of the last frame.
+Plays a show. With a show manifest (show.toml, see configs/shows/) it plays that show: its
+outputs, entry, devices and bindings, textures, kiosk policy (opening hours, attract loop,
+playlist) and status server. With none it plays the default show: LAVA's start-up scene, a
+coloured cube on black, 500x500, turning slowly under LAVA's default lights.
+The output is the manifest's, or detected: KMS when Basalt can be DRM master (no desktop
+running), a window when a display server is there, offscreen (headless) otherwise; the
+headless output writes a snapshot of the last frame.
 Without --frames or --seconds it runs until interrupted (Ctrl-C, SIGTERM) and exits cleanly.
+SIGHUP re-reads the manifest; the show plays on until the new one is ready.
+
+SHOW may be a LAVA script (.mdl), run as `lava -file SHOW.mdl` ran it: each `draw` is one
+frame, `quit` ends the run, and a bad line is reported and skipped while the show goes on.
+A script that quits runs as fast as possible on the manual clock unless --realtime is given.
+'basalt help script' lists the language; 'basalt check SHOW.mdl' finds errors without running.
 
 Options:
   --frames N         stop after N frames
   --seconds S        stop after S seconds of show time
-  --size WxH         output size in pixels (default 500x500)
-  --headless         render offscreen even when a display is available
+  --size WxH         output size in pixels (default: the manifest's, or 500x500)
+  --output KIND      auto, headless, kms or window (default: the manifest's, or auto)
+  --headless         render offscreen even when a display is available (--output headless)
   --snapshot PATH    write the last frame to PATH (format from the extension: .png, .jpg,
                      .tif, .exr, ...); default: OUTPUT_DIR/snapshot.png
   --output-dir DIR   folder for snapshots (default: out)
-  --fps F            show frame rate (default 60)
+  --fps F            show frame rate (default: the manifest's, or 60)
   --realtime         pace frames on the system clock at the frame rate
   --fast             step a manual clock exactly 1/fps per frame and render as fast as
                      possible (the default headless when --frames or --seconds is given)
+  --save-image PATH  where a script's save_image writes (default: OUTPUT_DIR/ras.im32)
+  --save-model PATH  at the end, write the show as a LAVA script (LAVA's Save Model)
+  --movie PART=FILE  play FILE as the texture of PART (LAVA's texture.switch = video),
+                     looping with no gap; repeat the option for more streams, or for the
+                     same PART to make a playlist
+  --movie-once       play movies once instead of looping
+  --zoom PART[=SCALE][@X,Y]
+                     show PART's movie as a picture over the scene (LAVA's Zoom): SCALE of
+                     its size (default 0.5), top-left corner at X,Y pixels (default 10,10)
+  --audio            play the movies' sound on the default output
+  --record PATH      record the rendered output to PATH (.mp4, .mkv, .mov, .avi, .webm)
+  --record-codec C   h264, mjpeg, vp8, vp9 or auto (H.264; MJPEG for .avi; VP9 for .webm)
+  --record-frames N  stop recording after N frames (LAVA's Rec slider); default: the run
+  --replay PATH      play the devices recorded in a trace folder (basalt record) or an
+                     hid-recorder file as if they were plugged in; dials drive LAVA's dial table
+  --replay-once      play the recording once instead of looping
+  --clock-start T    with --fast: the calendar time the show starts at, for trying opening
+                     hours (2026-12-24T09:59:00Z)
+  --status ADDR:PORT serve status and controls there (default: the manifest's [status];
+                     port 0 picks a free one)
+  --state-dir DIR    where the show's resume point is kept (default: $STATE_DIRECTORY,
+                     else ~/.local/state/basalt)
+  --no-resume        start from the beginning, not where the show was before it stopped
   -h, --help         this text
 
 Exit status: 0 when the show ran, 1 when it could not start or failed, 2 for usage errors.
 )";
 }
+
+namespace {
+
+Result<WallTime> parseClockStart(std::string_view text) {
+  // 2026-12-24T09:59:00Z (UTC).
+  const auto bad = [&] {
+    return fail(Errc::kInvalidArgument,
+                fmt::format("--clock-start needs a UTC time like 2026-12-24T09:59:00Z, not '{}'", text));
+  };
+  if (text.size() != 20 || text[10] != 'T' || text[19] != 'Z') return bad();
+  auto date = parseDate(text.substr(0, 10));
+  auto h = integerOption("--clock-start", text.substr(11, 2), 0, 23);
+  auto m = integerOption("--clock-start", text.substr(14, 2), 0, 59);
+  auto sec = integerOption("--clock-start", text.substr(17, 2), 0, 59);
+  if (!date || !h || !m || !sec || text[13] != ':' || text[16] != ':') return bad();
+  const std::int64_t days = daysFromCivil(date->year, date->month, date->day);
+  return WallTime{std::chrono::seconds(days * 86400 + *h * 3600 + *m * 60 + *sec)};
+}
+
+}  // namespace
 
 Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
   auto parsed = parseOptions("run", args,
@@ -103,18 +172,44 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--frames", true},
                               {"--seconds", true},
                               {"--size", true},
+                              {"--output", true},
                               {"--headless"},
                               {"--snapshot", true},
                               {"--output-dir", true},
                               {"--fps", true},
                               {"--realtime"},
-                              {"--fast"}});
+                              {"--fast"},
+                              {"--save-image", true},
+                              {"--save-model", true},
+                              {"--movie", true},
+                              {"--movie-once"},
+                              {"--zoom", true},
+                              {"--audio"},
+                              {"--record", true},
+                              {"--record-codec", true},
+                              {"--record-frames", true},
+                              {"--replay", true},
+                              {"--replay-once"},
+                              {"--clock-start", true},
+                              {"--status", true},
+                              {"--state-dir", true},
+                              {"--no-resume"}});
   if (!parsed) return std::unexpected(parsed.error());
   RunOptions run;
   for (const ParsedOption& o : *parsed) {
     if (o.name.empty()) {
-      return fail(Errc::kInvalidArgument,
-                  fmt::format("unexpected argument '{}' for 'basalt run'; see 'basalt run --help'", o.value));
+      if (run.manifest || run.show) {
+        return fail(Errc::kInvalidArgument,
+                    fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
+                                (run.manifest ? *run.manifest : *run.show).string()));
+      }
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
+      if (o.value.ends_with(".toml")) {
+        run.manifest = std::filesystem::path(o.value);
+      } else {
+        run.show = std::filesystem::path(o.value);  // a LAVA script; runShow says if it is not one
+      }
+      continue;
     }
     if (o.name == "--help") {
       run.help = true;
@@ -128,8 +223,24 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       run.seconds = *v;
     } else if (o.name == "--size") {
       if (auto r = parseSize(o.value, run); !r) return std::unexpected(r.error());
+      run.sizeGiven = true;
+    } else if (o.name == "--output") {
+      static constexpr std::pair<std::string_view, render::OutputKind> kKinds[] = {
+          {"auto", render::OutputKind::kAuto},
+          {"headless", render::OutputKind::kHeadless},
+          {"kms", render::OutputKind::kKms},
+          {"window", render::OutputKind::kWindow}};
+      const auto* it =
+          std::find_if(std::begin(kKinds), std::end(kKinds), [&](const auto& k) { return k.first == o.value; });
+      if (it == std::end(kKinds)) {
+        return fail(Errc::kInvalidArgument,
+                    fmt::format("--output must be auto, headless, kms or window, not '{}'", o.value));
+      }
+      run.output = it->second;
+      run.headless = it->second == render::OutputKind::kHeadless;
     } else if (o.name == "--headless") {
       run.headless = true;
+      run.output = render::OutputKind::kHeadless;
     } else if (o.name == "--snapshot") {
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "--snapshot needs a file name");
       run.snapshot = std::filesystem::path(o.value);
@@ -140,10 +251,65 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       auto v = numberOption(o.name, o.value, 1, 1000);
       if (!v) return std::unexpected(v.error());
       run.fps = *v;
+      run.fpsGiven = true;
     } else if (o.name == "--realtime") {
       run.clock = ClockMode::kSystem;
     } else if (o.name == "--fast") {
       run.clock = ClockMode::kManual;
+    } else if (o.name == "--save-image") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--save-image needs a file name");
+      run.saveImage = std::filesystem::path(o.value);
+    } else if (o.name == "--save-model") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--save-model needs a file name");
+      run.saveModel = std::filesystem::path(o.value);
+    } else if (o.name == "--movie") {
+      auto m = parseMovieOption(o.value);
+      if (!m) return std::unexpected(m.error());
+      run.movies.push_back(std::move(*m));
+    } else if (o.name == "--movie-once") {
+      run.movieOnce = true;
+    } else if (o.name == "--zoom") {
+      auto z = parseZoomOption(o.value);
+      if (!z) return std::unexpected(z.error());
+      run.zooms.push_back(std::move(*z));
+    } else if (o.name == "--audio") {
+      run.audio = true;
+    } else if (o.name == "--record") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--record needs a file name");
+      run.record = std::filesystem::path(o.value);
+    } else if (o.name == "--record-codec") {
+      auto c = media::parseVideoCodec(o.value);
+      if (!c) return std::unexpected(c.error());
+      run.recordCodec = std::string(o.value);
+    } else if (o.name == "--record-frames") {
+      auto n = integerOption(o.name, o.value, 1, INT64_MAX);
+      if (!n) return std::unexpected(n.error());
+      run.recordFrames = *n;
+    } else if (o.name == "--replay") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--replay needs a trace folder or .hid file");
+      run.replay = std::filesystem::path(o.value);
+    } else if (o.name == "--replay-once") {
+      run.replayOnce = true;
+    } else if (o.name == "--clock-start") {
+      auto t = parseClockStart(o.value);
+      if (!t) return std::unexpected(t.error());
+      run.clockStart = *t;
+    } else if (o.name == "--status") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--status needs ADDRESS:PORT, e.g. 127.0.0.1:8180");
+      run.statusListen = std::string(o.value);
+    } else if (o.name == "--state-dir") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--state-dir needs a folder");
+      run.stateDir = std::filesystem::path(o.value);
+    } else if (o.name == "--no-resume") {
+      run.resume = false;
+    }
+  }
+  for (const auto& [name, zoom] : run.zooms) {
+    const bool known =
+        std::any_of(run.movies.begin(), run.movies.end(), [&](const auto& m) { return m.first == name; });
+    if (!known) {
+      return fail(Errc::kInvalidArgument,
+                  fmt::format("--zoom {}: no movie of that name; give --movie {}=FILE too", name, name));
     }
   }
   return run;
@@ -159,41 +325,284 @@ int runMain(std::span<const std::string_view> args) {
   return runShow(*options);
 }
 
-int runShow(const RunOptions& options) {
-  const std::filesystem::path snapshotPath = options.snapshot ? *options.snapshot : options.outputDir / "snapshot.png";
-  if (auto r = checkWritableFolder(snapshotPath); !r) return failWith(r.error(), "cannot start");
+namespace {
 
+std::string_view kindName(render::OutputKind kind) {
+  switch (kind) {
+    case render::OutputKind::kAuto: return "auto";
+    case render::OutputKind::kHeadless: return "headless";
+    case render::OutputKind::kKms: return "kms";
+    case render::OutputKind::kWindow: return "window";
+  }
+  return "?";
+}
+
+render::OutputKind toRenderKind(OutputKind kind) {
+  switch (kind) {
+    case OutputKind::kAuto: return render::OutputKind::kAuto;
+    case OutputKind::kHeadless: return render::OutputKind::kHeadless;
+    case OutputKind::kKms: return render::OutputKind::kKms;
+    case OutputKind::kWindow: return render::OutputKind::kWindow;
+  }
+  return render::OutputKind::kAuto;
+}
+
+/// Reads and validates the manifest (the files it names must exist inside the show folder; their
+/// contents are read as the show loads them, and `basalt check` parses them all beforehand);
+/// prints its errors and warnings.
+std::optional<Manifest> readShowManifest(const std::filesystem::path& file) {
+  Diagnostics diagnostics;
+  auto manifest = readManifest(file, diagnostics);
+  for (const Diagnostic& d : diagnostics.items()) {
+    if (d.severity != Severity::kNote) fmt::print(stderr, "{}\n", d.format());
+  }
+  if (!manifest) {
+    fmt::print(stderr,
+               "basalt: error: cannot start: {} has {} problem{} (above); 'basalt check {}' lists them without "
+               "starting\n",
+               file.string(), diagnostics.errorCount(), diagnostics.errorCount() == 1 ? "" : "s", file.string());
+  }
+  return manifest;
+}
+
+/// "127.0.0.1:8180" or "[::1]:0" into the status spec.
+Result<void> applyStatusListen(std::string_view listen, StatusSpec& spec) {
+  std::string_view host;
+  std::string_view port;
+  if (listen.starts_with('[')) {
+    const auto close = listen.find("]:");
+    if (close == std::string_view::npos) return fail(Errc::kInvalidArgument, "--status needs [ADDRESS]:PORT");
+    host = listen.substr(1, close - 1);
+    port = listen.substr(close + 2);
+  } else {
+    const auto colon = listen.rfind(':');
+    if (colon == std::string_view::npos) return fail(Errc::kInvalidArgument, "--status needs ADDRESS:PORT");
+    host = listen.substr(0, colon);
+    port = listen.substr(colon + 1);
+  }
+  auto p = integerOption("--status", port, 0, 65535);
+  if (!p) return std::unexpected(p.error());
+  spec.enabled = true;
+  spec.host = std::string(host);
+  spec.port = static_cast<std::uint16_t>(*p);
+  if (!spec.loopbackOnly() && spec.token.empty() && spec.tokenFile.empty()) {
+    return fail(Errc::kInvalidArgument, fmt::format("--status {} opens the server beyond this machine; that needs a "
+                                                    "token (status.token_file in show.toml)",
+                                                    listen));
+  }
+  return {};
+}
+
+}  // namespace
+
+int runShow(const RunOptions& options) {
+  Manifest manifest = Manifest::builtinDefault();
+  if (options.manifest) {
+    auto read = readShowManifest(*options.manifest);
+    if (!read) return 1;
+    manifest = std::move(*read);
+  }
+  if (stderrIsJournal()) logToJournal(manifest.name);
+
+  const std::filesystem::path snapshotPath = options.snapshot ? *options.snapshot : options.outputDir / "snapshot.png";
+  if (options.show && !isScriptFile(*options.show)) {
+    return usageError(
+        fmt::format("basalt run plays show manifests and LAVA scripts (.mdl); '{}' is neither: give a show manifest "
+                    "(show.toml) or a script",
+                    options.show->string()));
+  }
+  if (auto r = checkWritableFolder(snapshotPath); !r) return failWith(r.error(), "cannot start");
+  if (options.statusListen) {
+    if (auto r = applyStatusListen(*options.statusListen, manifest.status); !r)
+      return failWith(r.error(), "cannot start");
+  }
+
+  std::optional<script::Interpreter> script;
+  if (options.show) {
+    auto loaded = loadScript(*options.show);
+    if (!loaded) return failWith(loaded.error(), "cannot start");
+    script.emplace(std::move(*loaded));
+  }
+
+  const double fps = options.fpsGiven || !options.manifest ? options.fps : manifest.fps;
   std::int64_t maxFrames = -1;
   if (options.frames) maxFrames = *options.frames;
   if (options.seconds) {
-    const auto fromSeconds = static_cast<std::int64_t>(std::ceil(*options.seconds * options.fps));
+    const auto fromSeconds = static_cast<std::int64_t>(std::ceil(*options.seconds * fps));
     maxFrames = maxFrames < 0 ? fromSeconds : std::min(maxFrames, fromSeconds);
   }
-  const bool manual = options.clock == ClockMode::kManual || (options.clock == ClockMode::kAuto && maxFrames >= 0);
+  // A script that quits is a batch job (LAVA's test scripts): it runs as fast as it can.
+  const bool batch = maxFrames >= 0 || (script && scriptQuits(script->program()));
+  const bool manual = options.clock == ClockMode::kManual || (options.clock == ClockMode::kAuto && batch);
   SystemClock systemClock;
-  ManualClock manualClock;
+  ManualClock manualClock(Nanos{0}, options.clockStart ? *options.clockStart : systemClock.wallNow());
   const Clock& clock = manual ? static_cast<const Clock&>(manualClock) : systemClock;
 
   auto loop = runtime::EventLoop::create(clock);
   if (!loop) return failWith(loop.error(), "cannot start the event loop");
+  // Signals are blocked before any thread starts (the state writer, the status server, the
+  // renderer's), so that every thread inherits the mask and only the loop receives them.
+  FrameLoop* stopTarget = nullptr;
+  ShowDirector* reloadTarget = nullptr;
+  bool stopBeforeLoop = false;
+  auto signals = (*loop)->watchSignals({SIGINT, SIGTERM, SIGHUP}, [&](int signal) {
+    if (signal == SIGHUP) {
+      if (reloadTarget) reloadTarget->requestReload();
+    } else if (stopTarget) {
+      stopTarget->requestStop();
+    } else {
+      stopBeforeLoop = true;
+    }
+  });
+  if (!signals) return failWith(signals.error(), "cannot watch for signals");
 
-  // Only the headless output exists in this build; KMS and window outputs plug in here.
-  auto output = render::createHeadlessOutput({options.width, options.height});
-  if (!output) return failWith(output.error(), "cannot open the headless output");
+  render::OutputRequest request;
+  request.kind = options.output ? *options.output : toRenderKind(manifest.output.kind);
+  request.size = {options.width, options.height};
+  if (!options.sizeGiven && manifest.output.width > 0) request.size = {manifest.output.width, manifest.output.height};
+  request.drmDevice = manifest.output.device;
+  request.connector = manifest.output.connector;
+  if (manifest.output.mode) {
+    request.mode =
+        render::ModeWish{manifest.output.mode->width, manifest.output.mode->height, manifest.output.mode->refresh};
+  }
+  request.fullscreen = manifest.output.fullscreen;
+  request.title = "Basalt: " + manifest.name;
+  std::string passedOver;
+  auto output = render::openOutput(request, &passedOver);
+  if (!output) {
+    return failWith(output.error(), fmt::format("cannot open the {} output", request.kind == render::OutputKind::kAuto
+                                                                                 ? std::string_view("headless")
+                                                                                 : kindName(request.kind)));
+  }
+  if (!passedOver.empty()) {
+    std::string_view lines = passedOver;
+    while (!lines.empty()) {
+      const auto nl = lines.find('\n');
+      log::info(kLogRun, "output passed over: {}", lines.substr(0, nl));
+      lines = nl == std::string_view::npos ? std::string_view{} : lines.substr(nl + 1);
+    }
+  }
   auto renderer = render::Renderer::create();
   if (!renderer) return failWith(renderer.error(), "cannot set up the renderer");
 
-  runtime::Show show = runtime::Show::makeDefault();
-  FrameLoop frameLoop({options.fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output,
-                      **renderer);
+  StatusBoard board(systemClock.wallNow(), fps);
+  runtime::EventLoop* eventLoop = loop->get();
+  board.setWake([eventLoop] { eventLoop->wake(); });
+  BoundedQueue<Event> events(1024, [eventLoop] { eventLoop->wake(); });
+  auto supervisor = Supervisor::fromEnvironment();
 
-  auto stopOnSignal = (*loop)->watchSignals({SIGINT, SIGTERM}, [&frameLoop](int) { frameLoop.requestStop(); });
-  if (!stopOnSignal) return failWith(stopOnSignal.error(), "cannot watch for signals");
+  std::unique_ptr<StateStore> state;
+  std::optional<ResumePoint> resume;
+  if (options.manifest && manifest.kiosk.resume && options.resume) {
+    const std::filesystem::path folder = options.stateDir ? *options.stateDir : defaultStateFolder();
+    auto store = StateStore::open(folder, manifest.file.string());
+    if (store) {
+      state = std::move(*store);
+      resume = state->load();
+    } else {
+      log::warn(kLogRun, "{}; the show will not resume after a restart", store.error().message());
+    }
+  }
+
+  // Texture images are read in the background: the first frame does not wait for them.
+  auto loaded = loadShow(manifest, clock, false);
+  if (!loaded) return failWith(loaded.error(), "cannot load the show");
+
+  runtime::Show show;
+  FrameLoop frameLoop({fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output, **renderer);
+  ShowDirector director(
+      DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps});
+  director.install(std::move(*loaded), clock.now(), resume);
+  if (script) show = script::startupShow();  // a script starts from LAVA's start-up state
+
+  stopTarget = &frameLoop;
+  reloadTarget = &director;
+  if (stopBeforeLoop) frameLoop.requestStop();
+
+  std::unique_ptr<StatusServer> server;
+  if (manifest.status.enabled) {
+    auto started = StatusServer::start(manifest.status, board);
+    if (started) {
+      server = std::move(*started);
+      fmt::print("basalt: status server: {}\n", server->url());
+      std::fflush(stdout);
+    } else {
+      // The show matters more than its status page.
+      log::error(kLogRun, "{}; the show plays without it", started.error().describe());
+    }
+  }
+
+  FrameMetrics metrics(board, &events, (*output)->describe());
+  frameLoop.addParticipant(metrics);
+  frameLoop.addParticipant(director);
+  frameLoop.addParticipant(*supervisor);
+
+  std::optional<ScriptPlayer> player;
+  if (script) {
+    ScriptPlayerOptions playerOptions;
+    playerOptions.outputDir = options.outputDir;
+    if (options.saveImage) playerOptions.saveImage = *options.saveImage;
+    player.emplace(std::move(*script), show, **renderer, std::move(playerOptions));
+    player->setReporter(printScriptDiagnostic);
+    frameLoop.addParticipant(*player);
+  }
+
+  // Movies: GStreamer starts only when a show has some (start-up stays fast without).
+  std::unique_ptr<VideoStreams> videos;
+  if (!options.movies.empty()) {
+    std::vector<MovieStreamSpec> specs;
+    for (const auto& [name, file] : options.movies) {
+      auto same = std::find_if(specs.begin(), specs.end(), [&](const MovieStreamSpec& s) { return s.name == name; });
+      if (same == specs.end()) {
+        specs.push_back({name, {file}, !options.movieOnce, options.audio, std::nullopt});
+      } else {
+        same->files.push_back(file);  // the same part again: a playlist
+      }
+    }
+    for (const auto& [name, zoom] : options.zooms) {
+      for (MovieStreamSpec& s : specs) {
+        if (s.name == name) s.zoom = zoom;
+      }
+    }
+    auto v = VideoStreams::create(specs, show, **renderer, manual);
+    if (!v) return failWith(v.error(), "cannot start the movies");
+    videos = std::move(*v);
+    frameLoop.addParticipant(*videos);
+  }
+  // Recording comes after the movies so that it sees the Zoom pictures.
+  std::unique_ptr<ScreenRecorder> recorder;
+  if (options.record) {
+    media::RecorderOptions ro;
+    ro.path = *options.record;
+    ro.width = (*output)->size().width;
+    ro.height = (*output)->size().height;
+    ro.fps = fps;
+    ro.codec = *media::parseVideoCodec(options.recordCodec);
+    ro.maxFrames = options.recordFrames.value_or(-1);
+    ro.waitForEncoder = manual;  // offline runs keep every frame; live shows drop rather than wait
+    auto r = ScreenRecorder::create(ro);
+    if (!r) return failWith(r.error(), "cannot record");
+    recorder = std::move(*r);
+    frameLoop.addParticipant(*recorder);
+  }
+  // Devices: a replayed trace drives the show through LAVA's dial table.
+  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  std::unique_ptr<DeviceWiring> devices;
+  if (options.replay) {
+    devices = std::make_unique<DeviceWiring>(clock, [eventLoop] { eventLoop->wake(); });
+    if (auto r = devices->addReplay(*options.replay, !options.replayOnce); !r) {
+      return failWith(r.error(), "cannot replay");
+    }
+    frameLoop.addParticipant(devices->participant());
+    frameLoop.setEvents(&devices->events(), &bindings);
+    devices->start(manual);
+  }
 
   Image snapshot;
   bool snapshotWritten = false;
   frameLoop.setFrameHook([&](std::int64_t, bool last, render::Output& out) -> Result<void> {
-    if (!last) return {};
+    if (!last || out.kind() != "headless") return {};
     if (auto r = out.readBack(snapshot); !r) return r;
     if (auto r = media::writeImage(snapshotPath, snapshot); !r) return r;
     snapshotWritten = true;
@@ -201,16 +610,65 @@ int runShow(const RunOptions& options) {
   });
 
   auto stats = frameLoop.run();
+  std::vector<devices::DeviceStatus> deviceStatus;
+  if (devices) {
+    deviceStatus = devices->manager().status();
+    devices->stop();
+  }
+  supervisor->stopping();
+  server.reset();
   if (!stats) return failWith(stats.error(), "the show stopped");
 
-  const double fps = stats->wallSeconds > 0 ? static_cast<double>(stats->frames) / stats->wallSeconds : 0;
-  fmt::print("basalt: played the default show: {} frames in {:.2f} s ({:.1f} frames per second, {} clock)\n",
-             stats->frames, stats->wallSeconds, fps, manual ? "manual" : "system");
+  if (options.saveModel) {
+    const script::ObjectSource object = player ? player->interpreter().objectSource() : script::ObjectSource{};
+    if (auto r = writeSavedModel(*options.saveModel, script::saveModel(show, object)); !r) {
+      return failWith(r.error(), "cannot save the model");
+    }
+  }
+
+  const double rate = stats->wallSeconds > 0 ? static_cast<double>(stats->frames) / stats->wallSeconds : 0;
+  const std::string what = options.manifest ? fmt::format("'{}'", manifest.name)
+                           : options.show   ? options.show->string()
+                                            : std::string("the default show");
+  fmt::print("basalt: played {}: {} frames in {:.2f} s ({:.1f} frames per second, {} clock)\n", what, stats->frames,
+             stats->wallSeconds, rate, manual ? "manual" : "system");
   fmt::print("basalt: output: {}\n", (*output)->describe());
   fmt::print("basalt: first frame after {:.1f} ms\n", stats->firstFrameSeconds * 1000);
+  if (player) printScriptSummary(*player);
+  if (director.reloadsApplied() + director.reloadsFailed() > 0) {
+    const FrameFigures f = board.frameFigures();
+    fmt::print(
+        "basalt: reloads: {} applied, {} failed; frames missed at a reload: {} (longest frame at a reload "
+        "{:.1f} ms, median frame {:.1f} ms)\n",
+        director.reloadsApplied(), director.reloadsFailed(), f.missedAtReload, f.longestAtReload * 1e3,
+        f.intervalP50 * 1e3);
+  }
+  if (const KioskPolicy* policy = director.policy(); policy && options.manifest) {
+    fmt::print("basalt: at the end: {}\n", policy->describe());
+  }
   if (snapshotWritten) fmt::print("basalt: snapshot written to {}\n", snapshotPath.string());
+  if (options.saveModel) fmt::print("basalt: model saved to {}\n", options.saveModel->string());
+  if (videos) {
+    for (const std::string& line : videos->status()) fmt::print("basalt: {}\n", line);
+  }
+  int status = 0;
+  if (recorder) {
+    if (auto r = recorder->finish(); !r) {
+      std::fflush(stdout);
+      status = failWith(r.error(), "the recording failed (the show itself ran)");
+    } else {
+      fmt::print("basalt: recorded {} frames to {} ({})\n", recorder->frames(), recorder->options().path.string(),
+                 recorder->describe());
+    }
+  }
+  if (devices) {
+    for (const devices::DeviceStatus& s : deviceStatus) {
+      fmt::print("basalt: replayed {} '{}' ({})\n", devices::deviceKindName(s.kind), s.name,
+                 s.lastError.empty() ? std::string(devices::deviceStateName(s.state)) : s.lastError);
+    }
+  }
   std::fflush(stdout);
-  return 0;
+  return status;
 }
 
 }  // namespace basalt::kiosk

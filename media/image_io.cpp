@@ -14,6 +14,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <mutex>
 #include <system_error>
@@ -22,7 +24,9 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "media/netpbm.h"
 #include "media/oiio_module.h"
+#include "media/sun_raster.h"
 #include "runtime/log.h"
 
 namespace basalt::media {
@@ -124,6 +128,20 @@ Result<void> writeAtomically(const std::filesystem::path& path, WriteFn&& write)
   return {};
 }
 
+png_image pngHeaderFor(const Image& image) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = image.width;
+  png.height = image.height;
+  switch (image.channels) {
+    case 1: png.format = PNG_FORMAT_GRAY; break;
+    case 2: png.format = PNG_FORMAT_GA; break;
+    case 3: png.format = PNG_FORMAT_RGB; break;
+    default: png.format = PNG_FORMAT_RGBA; break;
+  }
+  return png;
+}
+
 Result<void> writePng(const std::filesystem::path& path, const Image& image) {
   png_image png{};
   png.version = PNG_IMAGE_VERSION;
@@ -144,14 +162,83 @@ Result<void> writePng(const std::filesystem::path& path, const Image& image) {
   return {};
 }
 
+/// Reads a whole image file for Basalt's own codecs (capped: 1 GiB is far beyond any texture).
+Result<std::vector<std::uint8_t>> readAll(const std::filesystem::path& path) {
+  constexpr std::uintmax_t kMaxBytes = std::uintmax_t{1} << 30;
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return fail(Errc::kIo, fmt::format("cannot read the file: {}", ec.message()), path.string());
+  if (size > kMaxBytes) return fail(Errc::kResourceExhausted, "the image file is larger than 1 GiB", path.string());
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) return fail(Errc::kIo, systemErrorText("cannot open the file", errno), path.string());
+  const std::size_t got = std::fread(bytes.data(), 1, bytes.size(), file);
+  std::fclose(file);
+  bytes.resize(got);
+  return bytes;
+}
+
+/// The first bytes of a file, to recognise formats Basalt decodes itself.
+std::vector<std::uint8_t> readHead(const std::filesystem::path& path) {
+  std::vector<std::uint8_t> head(8);
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) return {};
+  head.resize(std::fread(head.data(), 1, head.size(), file));
+  std::fclose(file);
+  return head;
+}
+
+Result<void> writeBytes(const std::filesystem::path& path, const std::vector<std::uint8_t>& bytes) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file) return fail(Errc::kIo, systemErrorText("cannot create the file", errno));
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
+  const bool closed = std::fclose(file) == 0;
+  if (!ok || !closed) return fail(Errc::kIo, "cannot write the image (is the disk full?)");
+  return {};
+}
+
 }  // namespace
+
+Result<std::vector<std::uint8_t>> encodePng(const Image& image) {
+  if (image.type != ChannelType::kU8 || image.channels < 1 || image.channels > 4 || image.empty()) {
+    return fail(Errc::kInvalidArgument, "only non-empty 8-bit images with 1 to 4 channels are encoded as PNG");
+  }
+  png_image png = pngHeaderFor(image);
+  png_alloc_size_t size = 0;
+  const auto stride = static_cast<png_int_32>(image.rowBytes());
+  if (!png_image_write_to_memory(&png, nullptr, &size, 0, image.pixels.data(), stride, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return fail(Errc::kIo, fmt::format("cannot encode the PNG: {}", message));
+  }
+  std::vector<std::uint8_t> bytes(size);
+  png = pngHeaderFor(image);
+  if (!png_image_write_to_memory(&png, bytes.data(), &size, 0, image.pixels.data(), stride, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    return fail(Errc::kIo, fmt::format("cannot encode the PNG: {}", message));
+  }
+  bytes.resize(size);
+  return bytes;
+}
 
 Result<void> writeImage(const std::filesystem::path& path, const Image& image) {
   if (image.empty() || image.channels < 1 || image.channels > 4 || image.pixels.size() < image.byteSize()) {
     return fail(Errc::kInvalidArgument, "the image to write is empty or malformed", path.string());
   }
-  if (lowerExtension(path) == ".png" && image.type == ChannelType::kU8) {
+  const std::string ext = lowerExtension(path);
+  if (ext == ".png" && image.type == ChannelType::kU8) {
     return writeAtomically(path, [&](const std::filesystem::path& tmp) { return writePng(tmp, image); });
+  }
+  if (const int depth = sunRasterDepthFor(ext, image.channels); depth != 0) {
+    auto bytes = encodeSunRaster(image, depth);
+    if (!bytes) return std::unexpected(bytes.error().at(path.string()));
+    return writeAtomically(path, [&](const std::filesystem::path& tmp) { return writeBytes(tmp, *bytes); });
+  }
+  if (ext == ".pam") {
+    auto bytes = encodeNetpbm(image, true);
+    if (!bytes) return std::unexpected(bytes.error().at(path.string()));
+    return writeAtomically(path, [&](const std::filesystem::path& tmp) { return writeBytes(tmp, *bytes); });
   }
   auto api = oiio();
   if (!api) return std::unexpected(api.error().at(path.string()));
@@ -169,6 +256,20 @@ Result<Image> readImage(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
     return fail(Errc::kNotFound, "no such image file", path.string());
+  }
+  // Formats Basalt decodes itself are recognised by their first bytes, whatever the name says.
+  const std::vector<std::uint8_t> head = readHead(path);
+  const bool sun = head.size() >= 4 && (std::uint32_t{head[0]} << 24 | std::uint32_t{head[1]} << 16 |
+                                        std::uint32_t{head[2]} << 8 | head[3]) == kSunRasterMagic;
+  if (sun || looksLikeNetpbm(head)) {
+    auto bytes = readAll(path);
+    if (!bytes) return std::unexpected(bytes.error());
+    auto image = sun ? decodeSunRaster(*bytes) : decodeNetpbm(*bytes);
+    if (!image) {
+      return fail(image.error().code(), fmt::format("cannot read the image: {}", image.error().message()),
+                  path.string());
+    }
+    return image;
   }
   auto api = oiio();
   if (!api) return std::unexpected(api.error().at(path.string()));

@@ -17,7 +17,17 @@ namespace {
 
 void setError(char* error, std::size_t size, const std::string& text) {
   if (size == 0) return;
-  std::snprintf(error, size, "%s", text.c_str());
+  // OIIO's messages may span lines; Basalt's messages are one line.
+  std::string line;
+  for (char c : text) {
+    if (c == '\n') {
+      if (!line.empty() && line.back() != ' ') line += "; ";
+    } else {
+      line += c;
+    }
+  }
+  while (!line.empty() && (line.back() == ' ' || line.back() == ';')) line.pop_back();
+  std::snprintf(error, size, "%s", line.c_str());
 }
 
 OIIO::TypeDesc typeFor(std::uint32_t bytesPerChannel) {
@@ -69,6 +79,15 @@ int readImage(const char* path, BasaltOiioImage* out, char* error, std::size_t e
   }
   if (static_cast<long long>(spec.width) * spec.height > 16384LL * 16384LL) {
     setError(error, errorSize, "the image is larger than 16384x16384 pixels");
+    return 1;
+  }
+  // Decode first, so that a broken file reports the decoder's reason (reorient would only say
+  // that it failed).
+  if (!source.read(0, 0, true, OIIO::TypeDesc::UNKNOWN) || source.has_error()) {
+    std::string why = source.geterror();
+    if (why.empty()) why = "the decoder gave up without saying why";
+    (void)OIIO::geterror();  // taken, so that OIIO does not print it again at exit
+    setError(error, errorSize, why);
     return 1;
   }
   // EXIF orientation: turn the pixels so that row 0 is the top as the camera meant it.

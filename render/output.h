@@ -1,11 +1,12 @@
 #pragma once
 
 /// \file
-/// \brief Where frames go: the Output interface and the headless output. KMS and window
-/// outputs implement the same interface (DESIGN.md §3).
+/// \brief Where frames go: the Output interface, the headless output, and choosing between
+/// headless, KMS (render/kms_output.h) and window (render/window_output.h) outputs (DESIGN.md §3).
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -46,6 +47,14 @@ class Output {
   [[nodiscard]] virtual int paceFd() const { return -1; }
   /// \brief Handles readiness of paceFd() (reads the DRM event).
   virtual void onPaceReady() {}
+  /// \brief False while the previous frame is still waiting to reach the screen (a page flip
+  /// pending): the frame loop waits on paceFd() before drawing the next one.
+  [[nodiscard]] virtual bool readyForFrame() const { return true; }
+  /// \brief Switches the display off (KMS DPMS) or back on. Outputs without a display to
+  /// switch answer kUnsupported; the caller then shows black instead.
+  [[nodiscard]] virtual Result<void> setDisplayPower(bool on);
+  /// \brief True once the person at a window closed it (window output only).
+  [[nodiscard]] virtual bool closeRequested() const { return false; }
 };
 
 /// \brief Renders into an offscreen framebuffer on EGL's surfaceless platform (Mesa): no
@@ -58,5 +67,31 @@ Result<std::unique_ptr<Output>> createHeadlessOutput(Size size);
 
 /// \brief Reads the bound read framebuffer's `size` into `out` as RGBA8, top row first.
 Result<void> readFramebuffer(Size size, Image& out);
+
+/// \brief Which output to open. `kAuto` detects in DESIGN.md §3's order: KMS when the process
+/// can be DRM master, a window when a display server is present, headless otherwise.
+enum class OutputKind : std::uint8_t { kAuto, kHeadless, kKms, kWindow };
+
+/// \brief A display mode asked for: exact size, and refresh within half a hertz when not 0.
+struct ModeWish {
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  double refresh = 0;
+};
+
+/// \brief Everything an output may be asked for; each kind reads what applies to it.
+struct OutputRequest {
+  OutputKind kind = OutputKind::kAuto;
+  Size size{500, 500};           ///< headless and window
+  std::string drmDevice;         ///< KMS: /dev/dri/cardN; empty = the first card with a display
+  std::string connector;         ///< KMS: "HDMI-A-1"; empty = the first connected
+  std::optional<ModeWish> mode;  ///< KMS: empty = the connector's preferred mode
+  bool fullscreen = false;       ///< window
+  std::string title = "Basalt";  ///< window
+};
+
+/// \brief Opens the output the request names. With kAuto, tries KMS, then a window, then
+/// headless, and `why` (when given) receives one line per output it passed over and why.
+Result<std::unique_ptr<Output>> openOutput(const OutputRequest& request, std::string* why = nullptr);
 
 }  // namespace basalt::render

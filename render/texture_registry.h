@@ -16,11 +16,16 @@
 namespace basalt::render {
 
 /// \brief What the renderer samples for a texture name. `id` is an RGBA-sampling GL_TEXTURE_2D.
+///
+/// Orientation: texture row 0 (t = 0) holds the image's top row, as glTexImage2D stores an image
+/// read top row first; a stream that renders its frames the other way up sets `bottomUp`. The
+/// renderer maps OBJ-style coordinates (v = 0 at the image's bottom) accordingly.
 struct TextureView {
   GLuint id = 0;
   Size size;
   bool hasAlpha = false;
   std::uint64_t generation = 0;  ///< bumped whenever the contents change (streams: per new frame)
+  bool bottomUp = false;         ///< row 0 is the image's bottom row
 };
 
 /// \brief Owns image textures and refers to stream textures, by name.

@@ -21,7 +21,7 @@ enum class EventKind : std::uint8_t {
   kKey,            ///< keyboard key `index` (Linux input key code); value 1 down, 0 up, 2 repeat
   kPointerMotion,  ///< pointer moved; `index` 0 = x, 1 = y; value in pixels (relative)
   kPointerButton,  ///< pointer button `index` (0 left, 1 middle, 2 right); value 1 down, 0 up
-  kDeviceState,    ///< the device's state changed; value is the new DeviceState as a number
+  kDeviceState,    ///< the device became live (value 1) or was lost (value 0); its bindings go quiet
 };
 
 /// \brief A timestamped value from one input of one device. Trivially copyable, so queues of

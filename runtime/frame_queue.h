@@ -15,10 +15,26 @@
 
 namespace basalt {
 
+/// \brief Whether a source is delivering pictures, for the fallback a texture stream shows.
+enum class SourceState : std::uint8_t {
+  kLive,     ///< frames flow (or may flow: a paused movie is live)
+  kWaiting,  ///< not delivered yet: the device is absent or opening
+  kLost,     ///< was delivering and stopped: unplugged, signal lost, stalled; reopening by itself
+};
+
+/// \brief A source's state and the Clock time it entered it ("lost since 12:03:07").
+struct SourceHealth {
+  SourceState state = SourceState::kLive;
+  Nanos since{0};
+};
+
 /// \brief A stream of frames the renderer can show: a movie, a camera, a capture card.
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
+  /// \brief The source's state, so that a texture stream can show its configured fallback (last
+  /// frame, a test pattern or a colour) while it is not live. Any thread; never blocks.
+  [[nodiscard]] virtual SourceHealth health() const { return {}; }
   /// \brief The frame to show at `showTime`: the newest frame whose pts is at or before it, or
   /// an empty ref when no new frame is due (keep showing the last one). Called on the frame
   /// loop's thread; never blocks.

@@ -6,15 +6,17 @@ set -uo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$top/build}
 cd "$top"
+# Logs go to a folder of this run's own: several checkouts may lint at once on one machine.
+logs=$(mktemp -d "${TMPDIR:-/tmp}/basalt-lint.XXXXXX")
 mapfile -t sources < <(git ls-files -co --exclude-standard -- '*.cpp' '*.h' | grep -E '^(runtime|devices|media|render|kiosk|sim|tests)/')
 status=0
 
 if [ "${LINT_FIX:-0}" = 1 ]; then
   clang-format-19 -i "${sources[@]}"
 else
-  if ! clang-format-19 --dry-run --Werror "${sources[@]}" 2>/tmp/basalt-format.log; then
+  if ! clang-format-19 --dry-run --Werror "${sources[@]}" 2>"$logs/format.log"; then
     echo "lint: these files are not formatted (run LINT_FIX=1 scripts/lint.sh):"
-    grep -oE '^[^:]+\.(cpp|h)' /tmp/basalt-format.log | sort -u | sed 's/^/  /'
+    grep -oE '^[^:]+\.(cpp|h)' "$logs/format.log" | sort -u | sed 's/^/  /'
     status=1
   fi
 fi
@@ -27,10 +29,13 @@ mapfile -t units < <(printf '%s\n' "${sources[@]}" | grep '\.cpp$')
 # Compile commands come from g++; options only g++ knows are ignored by clang.
 if ! printf '%s\n' "${units[@]}" | xargs -P "$(nproc)" -n 4 clang-tidy-19 -p "$build" --quiet \
     --extra-arg=-Wno-unknown-warning-option --extra-arg=-Wno-unused-command-line-argument \
-    > /tmp/basalt-tidy.log 2>&1; then
-  grep -E 'warning:|error:' /tmp/basalt-tidy.log | sort -u | head -50
-  echo "lint: clang-tidy found problems (full log: /tmp/basalt-tidy.log)"
+    > "$logs/tidy.log" 2>&1; then
+  grep -E 'warning:|error:' "$logs/tidy.log" | sort -u | head -50
+  echo "lint: clang-tidy found problems (full log: $logs/tidy.log)"
   status=1
 fi
-[ $status -eq 0 ] && echo "lint: clean (clang-format, clang-tidy)"
+if [ $status -eq 0 ]; then
+  echo "lint: clean (clang-format, clang-tidy)"
+  rm -rf "$logs"
+fi
 exit $status

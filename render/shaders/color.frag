@@ -1,8 +1,12 @@
-#version 300 es
-precision highp float;
+// Unlit geometry, fragment stage: the colour through the shared epilogue.
 
 uniform vec4 uColor;
 
-out vec4 fragColor;
+in vec4 vColor;
 
-void main() { fragColor = uColor; }
+void main() {
+  clipFragment();
+  vec4 c = vColor.r < 0.0 ? uColor : vColor;
+  c.rgb = atmosphere(c.rgb);
+  writeColor(c);
+}

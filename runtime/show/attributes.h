@@ -323,7 +323,12 @@ struct DepthCue {
 
 enum class FogMode : std::uint8_t { kNone, kLinear, kExp, kExp2 };
 
-/// \brief Thesis §4.3.3 fog.
+/// \brief Thesis §4.3.3 fog, OpenGL's fog functions on the eye-space depth z of each pixel (in
+/// window units, the eye sits `view.perspective` units from the object's centre):
+/// linear f = (end - z) / (end - start), exp f = e^(-density z), exp2 f = e^(-(density z)^2),
+/// f clamped to 0..1, and the colour f C + (1 - f) fog colour. Fog is off unless `mode` says so;
+/// the thesis gives no defaults for the rest (Basalt defaults, chosen to fog the far half of
+/// the default view).
 struct Fog {
   FogMode mode = FogMode::kNone;
   Color3 color{0.5f, 0.5f, 0.5f};
@@ -337,12 +342,16 @@ enum class TextureSource : std::uint8_t { kOff, kImage, kVideo };
 enum class TextureMethod : std::uint8_t { kPixel, kVertexLevel };
 enum class TextureApprox : std::uint8_t { kNumSegments, kPixelTolerance, kCombined };
 
+/// \brief LAVA "Texture Mapping" (§6.2.2). `source` switches texturing as a whole: a part that
+/// names a texture (`PartState::texture`) shows it unless the source is kOff. Image files and
+/// streams (movies, cameras) both reach the renderer through its texture registry, so kImage and
+/// kVideo draw the same way; the distinction is kept for the script and Save Model.
 struct TextureSettings {
-  TextureSource source = TextureSource::kOff;
+  TextureSource source = TextureSource::kImage;  // Basalt default (manual silent): parts show their textures
   TextureMethod method = TextureMethod::kPixel;  // Basalt default (manual silent)
   TextureApprox approx = TextureApprox::kNumSegments;
-  std::int32_t subsegments = 1;
-  std::int32_t pixelTolerance = 7;
+  std::int32_t subsegments = 1;     // VLTM "Num Segments": each triangle side cut into this many parts
+  std::int32_t pixelTolerance = 7;  // VLTM "Pixel Tolerance": longest sub-triangle side, in pixels
   std::int32_t tauFunction = 0;
   friend bool operator==(const TextureSettings&, const TextureSettings&) = default;
 };
@@ -392,6 +401,18 @@ struct Picking {
 
 enum class DeferralMode : std::uint8_t { kAsti, kAsap };
 
+/// \brief How `global.stereo_mode = on` is shown. With no stereo display the object "gets drawn
+/// twice into the same buffer" (LAVA §6.1): Basalt draws a red/cyan anaglyph (thesis §5.1).
+enum class StereoMode : std::uint8_t { kAnaglyph };
+
+/// \brief Thesis §5.1 stereo: two eyes `eyeSpacing` apart (thesis C.3 `eyespacing`, default
+/// 0.04), left eye red, right eye cyan, converging on the object's centre plane.
+struct StereoSettings {
+  StereoMode mode = StereoMode::kAnaglyph;
+  float eyeSpacing = 0.04f;  // thesis C.3 default, in window units
+  friend bool operator==(const StereoSettings&, const StereoSettings&) = default;
+};
+
 struct GlobalSettings {
   Color3 background{0, 0, 0};                   // "Default color is black"
   DeferralMode deferral = DeferralMode::kAsti;  // "Default is ASTI"
@@ -429,7 +450,7 @@ enum class ObjectScale : std::uint8_t { kHalfScreen, kFullScreen, kOriginal };
 /// \brief LAVA's "View" menu. The object is centred and scaled into window bounds -1..1, then
 /// seen from `perspective` units away on +Z (0 = orthographic).
 struct ViewSettings {
-  Vec3 center{0, 0, 0};                                // slider offsets, in window units
+  Vec3 center{0, 0, 0};                                // the centre used with kUseSlider, in object coordinates
   ObjectCenter objectCenter = ObjectCenter::kNone;     // Basalt default: the bounding-box centre
   ObjectScale objectScale = ObjectScale::kFullScreen;  // Basalt default (manual silent)
   float viewScale = 1.0f;
@@ -438,24 +459,38 @@ struct ViewSettings {
   friend bool operator==(const ViewSettings&, const ViewSettings&) = default;
 };
 
+/// \brief LAVA's floors: one square, or a grid of 8 x 8 (coarse) or 32 x 32 (fine) lit squares.
 enum class FloorKind : std::uint8_t { kNone, kSingleSquare, kCoarseGrid, kFineGrid };
 enum class FloorPrimType : std::uint8_t { kSolid, kWireframe };
 
-/// \brief LAVA "Environment": the floor and its fake shadow.
+/// \brief LAVA "Environment": the floor and its fake shadow. The floor is horizontal in the
+/// global frame (it turns with the global matrix, the object turns on it with the local one),
+/// centred under the object, four object radii wide; the shadow is the object squashed onto it.
 struct Environment {
   FloorKind floor = FloorKind::kNone;
   Color3 floorColor{0.5f, 0.5f, 0.5f};  // Basalt default (manual silent)
   FloorPrimType floorPrimType = FloorPrimType::kSolid;
-  float floorPosition = 0.0f;  // 0 touches the bottom of the object
-  bool shadow = false;
-  float shadowDarkness = 0.5f;  // fraction of floor colour; Basalt default
+  float floorPosition = 0.0f;   // window units above the object's lowest point; 0 touches it
+  bool shadow = false;          // "only available when a floor is drawn"
+  float shadowDarkness = 0.5f;  // shadow colour = this fraction of the lit floor colour; Basalt default
   friend bool operator==(const Environment&, const Environment&) = default;
 };
 
+/// \brief What is drawn behind the scene (thesis §4.3.2, Performer's pfEarthSky): the
+/// background colour; a flat image (`Show::backgroundImage()`, a texture name) stretched over the
+/// view; a skybox from one 3 x 2 image of six 90-degree views (-X, +Z, +X on the top row, -Y,
+/// +Y, -Z below; each face in the OpenGL cube-map orientation that skybox sets are made in);
+/// or the earth-sky model.
 enum class BackgroundKind : std::uint8_t { kColor, kImage, kSkybox, kEarthSky };
+/// \brief pfESkyMode: kFast and kTag clear to the clear colour; kSky draws the sky and the
+/// horizon band on both sides of the horizon, the clear colour below it; kSkyGround draws sky,
+/// horizon and ground; kSkyClear draws the sky down to the horizon and the clear colour below.
 enum class EarthSkyClear : std::uint8_t { kFast, kTag, kSky, kSkyGround, kSkyClear };
 
-/// \brief Performer's pfEarthSky (Performer chapter 6, table 6-2 defaults).
+/// \brief Performer's pfEarthSky (Performer chapter 6, table 6-2 defaults). Up is world +Y; the
+/// sky shades from `skyBottom` at `horizonAngle` degrees above the horizon to `skyTop` at the
+/// zenith, the horizon colour fills the band between, and the ground runs from `groundFar` at the
+/// horizon to `groundNear` straight down. A viewer below `groundHeight` sees no ground.
 struct EarthSky {
   EarthSkyClear mode = EarthSkyClear::kFast;
   Color3 skyTop{0.0f, 0.0f, 0.44f};

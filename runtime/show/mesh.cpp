@@ -30,6 +30,7 @@ Mesh::Mesh(const Mesh& other)
       edges(other.edges),
       lines(other.lines),
       points(other.points),
+      facetSizes(other.facetSizes),
       parts(other.parts),
       materials(other.materials),
       id_(nextId()) {}

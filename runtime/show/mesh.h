@@ -24,6 +24,12 @@ struct Material {
   float shininess = 0;
   float opacity = 1;
   std::string diffuseMap;  ///< texture file, resolved against the model's folder
+  // Other maps an MTL file names (`map_bump`/`bump`, `refl`, `map_d`), resolved the same way.
+  // Recorded so that they survive a save; the renderer draws only the diffuse map today.
+  std::string bumpMap;
+  std::string reflectionMap;
+  std::string alphaMap;
+  friend bool operator==(const Material&, const Material&) = default;
 };
 
 /// \brief A named group of primitives (OBJ `g`/`o`, a cube face): what LAVA attributes address.
@@ -42,6 +48,8 @@ struct MeshPart {
   std::uint32_t pointIndexCount = 0;
   std::int32_t material = -1;    ///< index into Mesh::materials, -1 for none
   std::uint32_t facetCount = 0;  ///< polygons before triangulation (LAVA's "Facets")
+  std::uint32_t firstFacet = 0;  ///< index of the part's first polygon in Mesh::facetSizes
+  friend bool operator==(const MeshPart&, const MeshPart&) = default;
 };
 
 struct Bounds {
@@ -77,6 +85,11 @@ class Mesh {
   std::vector<std::uint32_t> edges;
   std::vector<std::uint32_t> lines;   ///< 2 indices per segment, grouped by part
   std::vector<std::uint32_t> points;  ///< 1 index per point, grouped by part
+  /// The polygons before triangulation, in part order: polygon k has facetSizes[k] corners,
+  /// owns the next facetSizes[k] segments of `edges` (its outline, corner i to corner i+1, so
+  /// the corners are the first index of each segment) and the next facetSizes[k] - 2 triangles.
+  /// Empty when the mesh's producer did not record polygons (each triangle is then a facet).
+  std::vector<std::uint32_t> facetSizes;
   std::vector<MeshPart> parts;
   std::vector<Material> materials;
 

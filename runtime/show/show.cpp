@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace basalt::runtime {
 
@@ -32,6 +33,7 @@ Mat4 Show::worldTransform(NodeId id) const {
 
 void Show::clear() {
   nodes_.clear();
+  terrains_.clear();
   parts_.clear();
   resolved_.clear();
   resolvedAt_.clear();
@@ -52,6 +54,26 @@ Bounds Show::sceneBounds() const {
     }
   }
   return b;
+}
+
+NodeId Show::addTerrain(SceneNode node, std::shared_ptr<const HeightField> heights) {
+  const NodeId id = addNode(std::move(node));
+  if (heights) terrains_.push_back(std::move(heights));
+  return id;
+}
+
+std::optional<float> Show::terrainHeightAt(float x, float z) const {
+  for (const auto& t : terrains_) {
+    if (auto h = t->heightAt(x, z)) return h;
+  }
+  return std::nullopt;
+}
+
+std::optional<NodeId> Show::findNode(std::string_view name) const {
+  for (NodeId i = 0; i < nodes_.size(); ++i) {
+    if (nodes_[i].name == name) return i;
+  }
+  return std::nullopt;
 }
 
 PartId Show::internPart(const std::string& name) {
@@ -79,6 +101,10 @@ void Show::selectAll(bool selected) {
 
 void Show::setPartTexture(PartId id, std::string texture) { parts_[id].texture = std::move(texture); }
 
+void Show::setPartReflectionTexture(PartId id, std::string texture) {
+  parts_[id].reflectionTexture = std::move(texture);
+}
+
 void Show::clearPartAttr(PartId id, AttrId attr) {
   parts_[id].mask.reset(static_cast<std::size_t>(attr));
   ++styleRevision_;
@@ -99,6 +125,7 @@ void Show::resetAttributes() {
     p.mask.reset();
     p.selected = true;
     p.texture.clear();
+    p.reflectionTexture.clear();
   }
   ++styleRevision_;
   lights_ = defaultLights();
@@ -116,6 +143,35 @@ void Show::resetAttributes() {
   backgroundKind_ = BackgroundKind::kColor;
   backgroundImage_.clear();
   earthSky_ = {};
+  stereo_ = {};
+  viewer_ = {};
+}
+
+void PerformanceMeter::recordFrame(const FrameCounts& counts, Nanos now) {
+  triangles = counts.triangles;
+  lines = counts.lines;
+  points = counts.points;
+  parts = counts.parts;
+  facets = counts.facets;
+  if (!sampleStarted_) {
+    // The first frame opens the sample; rates count the frames drawn after it.
+    sampleStarted_ = true;
+    sampleStart_ = now;
+    sampleFrames_ = 0;
+    samplePrimitives_ = 0;
+    return;
+  }
+  ++sampleFrames_;
+  samplePrimitives_ += counts.triangles + counts.lines + counts.points;
+  const double elapsed = toSeconds(now - sampleStart_);
+  const double period = samplePeriodSeconds > 0 ? samplePeriodSeconds : 2.0;
+  if (elapsed < period) return;
+  framesPerSecond = static_cast<double>(sampleFrames_) / elapsed;
+  primitivesPerSecond = static_cast<double>(samplePrimitives_) / elapsed;
+  ++updates;
+  sampleStart_ = now;
+  sampleFrames_ = 0;
+  samplePrimitives_ = 0;
 }
 
 namespace {
@@ -165,7 +221,7 @@ void Show::advanceFrame() {
   ++frameNumber_;
 }
 
-ViewTransforms computeView(const Show& show, float aspect) {
+Mat4 viewNormalisation(const Show& show) {
   const ViewSettings& v = show.view();
   const Bounds b = show.sceneBounds();
 
@@ -188,10 +244,15 @@ ViewTransforms computeView(const Show& show, float aspect) {
     case ObjectScale::kHalfScreen: scale = 0.5f / radius; break;
     case ObjectScale::kOriginal: scale = 1.0f; break;
   }
-  const Mat4 normalise = Mat4::scaling({scale, scale, scale}) * Mat4::translation(-center);
+  return Mat4::scaling({scale, scale, scale}) * Mat4::translation(-center);
+}
 
+ViewTransforms computeView(const Show& show, float aspect) { return computeEyeView(show, aspect, 0.0f); }
+
+ViewTransforms computeEyeView(const Show& show, float aspect, float eyeOffset) {
+  const ViewSettings& v = show.view();
   ViewTransforms t;
-  t.model = show.position().global * show.position().local * normalise;
+  t.model = show.position().global * show.position().local * viewNormalisation(show);
 
   // Window bounds -1..1 at the narrower dimension, shrunk or grown by the view scale.
   const float viewScale = v.viewScale > 0 ? v.viewScale : 1.0f;
@@ -200,20 +261,53 @@ ViewTransforms computeView(const Show& show, float aspect) {
   halfW /= viewScale;
   halfH /= viewScale;
   const float zClip = std::max(v.zClipScale, 1e-3f);
+  const float e = eyeOffset;
   if (v.perspective > 0) {
     const float d = v.perspective;
-    t.eye = {0, 0, d};
-    t.view = Mat4::translation({0, 0, -d});
+    t.eye = {e, 0, d};
+    t.view = Mat4::translation({-e, 0, -d});
     const float n = std::max(d - zClip, d * 1e-3f);
     const float f = d + zClip;
-    t.projection = Mat4::frustum(-halfW * n / d, halfW * n / d, -halfH * n / d, halfH * n / d, n, f);
+    // The window -halfW..halfW on the z = 0 plane, seen from the (moved) eye: an off-axis frustum.
+    const float k = n / d;
+    t.projection = Mat4::frustum((-halfW - e) * k, (halfW - e) * k, -halfH * k, halfH * k, n, f);
   } else {
     const float d = zClip + 1.0f;
-    t.eye = {0, 0, d};
+    t.eye = {e, 0, d};
     t.view = Mat4::translation({0, 0, -d});
-    t.projection = Mat4::orthographic(-halfW, halfW, -halfH, halfH, d - zClip, d + zClip);
+    // Parallel eyes see no parallax, so the eye's view is sheared instead: a point z window units
+    // in front of the centre plane moves by -e z / d, as it would seen in perspective from d.
+    Mat4 shear;
+    shear(0, 2) = -e / d;
+    shear(0, 3) = -e;  // view z = -d is the centre plane: it stays put
+    t.projection = Mat4::orthographic(-halfW, halfW, -halfH, halfH, d - zClip, d + zClip) * shear;
   }
   return t;
+}
+
+FloorGeometry computeFloor(const Show& show) {
+  FloorGeometry g;
+  const Mat4 object = show.position().local * viewNormalisation(show);
+  const Bounds b = show.sceneBounds();
+  float lowest = 0;
+  float radius = 1;
+  Vec3 centre{};
+  if (!b.empty) {
+    lowest = std::numeric_limits<float>::max();
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 c{(corner & 1) ? b.max.x : b.min.x, (corner & 2) ? b.max.y : b.min.y,
+                   (corner & 4) ? b.max.z : b.min.z};
+      lowest = std::min(lowest, object.transformPoint(c).y);
+    }
+    centre = object.transformPoint(b.center());
+    radius = std::max(length(object.transformPoint(b.max) - object.transformPoint(b.min)) * 0.5f, 1e-3f);
+  }
+  g.y = lowest + show.environment().floorPosition;
+  const float half = 2.0f * radius;
+  const Mat4& global = show.position().global;
+  g.floor = global * Mat4::translation({centre.x, g.y, centre.z}) * Mat4::scaling({half, 1, half});
+  g.shadow = global * Mat4::translation({0, g.y, 0}) * Mat4::scaling({1, 0, 1}) * object;
+  return g;
 }
 
 std::shared_ptr<const Mesh> makeColorCube() {
@@ -246,6 +340,8 @@ std::shared_ptr<const Mesh> makeColorCube() {
     for (std::uint32_t i : {0u, 1u, 1u, 2u, 2u, 3u, 3u, 0u}) mesh->edges.push_back(base + i);
     part.edgeIndexCount = 8;
     part.facetCount = 1;
+    part.firstFacet = static_cast<std::uint32_t>(mesh->facetSizes.size());
+    mesh->facetSizes.push_back(4);
     mesh->parts.push_back(std::move(part));
   }
   return mesh;

@@ -16,9 +16,11 @@
 #include <string_view>
 #include <vector>
 
+#include "runtime/clock.h"
 #include "runtime/math.h"
 #include "runtime/show/attributes.h"
 #include "runtime/show/mesh.h"
+#include "runtime/show/viewer.h"
 
 namespace basalt::runtime {
 
@@ -33,6 +35,13 @@ struct SceneNode {
   std::shared_ptr<const Mesh> mesh;  ///< null for grouping nodes; shared by instances
   std::vector<PartId> partIds;       ///< the Show part of each mesh part, same order
   bool visible = true;
+  /// Extended OBJ `usemap` maps (thesis C.2), resolved against the model's folder: the colour
+  /// map textures the node's parts that have no material map of their own; the spherical
+  /// reflection map and the bump map are recorded for the renderer ("" = none).
+  std::string colorMap;
+  std::string reflectionMap;
+  std::string bumpMap;
+  std::string source;  ///< the file the node was loaded from ("" for built-in geometry)
 };
 
 /// \brief A part as LAVA's "Part Selection" and per-part attributes see it.
@@ -42,9 +51,25 @@ struct PartState {
   PartStyle own;         ///< this part's settings where `mask` has the bit
   AttrMask mask;         ///< attributes set for this part (override global)
   std::string texture;   ///< texture source name ("" = none): file or stream
+  /// Sphere reflection map (thesis §4.2.6.2, Extended OBJ `usemap file reflect`): a texture name
+  /// whose image is a mirrored sphere; "" = none. Modulates the surface like the colour map.
+  std::string reflectionTexture;
 };
 
-/// \brief LAVA's performance meter (§9), filled by the frame loop from the renderer's counts.
+/// \brief What one frame displayed, as LAVA's performance meter counts it (§9).
+struct FrameCounts {
+  std::uint64_t triangles = 0;
+  std::uint64_t lines = 0;
+  std::uint64_t points = 0;
+  std::uint64_t parts = 0;
+  std::uint64_t facets = 0;
+  friend bool operator==(const FrameCounts&, const FrameCounts&) = default;
+};
+
+/// \brief LAVA's performance meter (§9), filled by the frame loop from the renderer's counts
+/// and read by the status server. The counts are those of the last frame; the rates are
+/// updated once a sample period has passed: frames (and primitives, the sum of triangles,
+/// lines and points) drawn since the last update, divided by the time that passed.
 struct PerformanceMeter {
   std::uint64_t triangles = 0;
   std::uint64_t lines = 0;
@@ -54,6 +79,19 @@ struct PerformanceMeter {
   double framesPerSecond = 0;
   double primitivesPerSecond = 0;
   double samplePeriodSeconds = 2.0;  ///< "The default value is 2 seconds"
+  std::uint64_t updates = 0;         ///< how many times the rates were computed
+
+  /// \brief Records a frame drawn at `now` (any monotonic time base: the frame loop passes
+  /// real time so that the rates say how fast this machine draws).
+  void recordFrame(const FrameCounts& counts, Nanos now);
+  /// \brief Forgets the current sample (after a pause, or when the period changes).
+  void restartSample() { sampleFrames_ = 0, samplePrimitives_ = 0, sampleStarted_ = false; }
+
+ private:
+  std::uint64_t sampleFrames_ = 0;
+  std::uint64_t samplePrimitives_ = 0;
+  Nanos sampleStart_{0};
+  bool sampleStarted_ = false;
 };
 
 class Show {
@@ -71,6 +109,14 @@ class Show {
   /// so instances and repeated names are addressed together). Parents must be added first.
   NodeId addNode(SceneNode node);
   void setNodeTransform(NodeId id, const Mat4& local);
+  /// \brief The first node with this name.
+  [[nodiscard]] std::optional<NodeId> findNode(std::string_view name) const;
+  /// \brief Adds a terrain's grid node and keeps its height field for `terrainHeightAt`.
+  NodeId addTerrain(SceneNode node, std::shared_ptr<const HeightField> heights);
+  [[nodiscard]] const std::vector<std::shared_ptr<const HeightField>>& terrains() const { return terrains_; }
+  /// \brief Height of the first terrain under (x, z) in scene coordinates, if any: what keeps a
+  /// walking viewer on the ground (thesis §4.6).
+  [[nodiscard]] std::optional<float> terrainHeightAt(float x, float z) const;
   /// \brief The node's transform composed with all its parents'.
   [[nodiscard]] Mat4 worldTransform(NodeId id) const;
   /// \brief Removes all nodes and parts and resets every attribute: LAVA's "all attributes get
@@ -86,6 +132,7 @@ class Show {
   void setPartSelected(PartId id, bool selected);
   void selectAll(bool selected);
   void setPartTexture(PartId id, std::string texture);
+  void setPartReflectionTexture(PartId id, std::string texture);
 
   // ---- Attributes ----
   [[nodiscard]] const PartStyle& globalStyle() const { return global_; }
@@ -141,6 +188,13 @@ class Show {
   [[nodiscard]] const std::string& backgroundImage() const { return backgroundImage_; }
   EarthSky& earthSky() { return earthSky_; }
   [[nodiscard]] const EarthSky& earthSky() const { return earthSky_; }
+  /// \brief Eye spacing and how stereo is shown; `global().stereo` switches it on.
+  StereoSettings& stereo() { return stereo_; }
+  [[nodiscard]] const StereoSettings& stereo() const { return stereo_; }
+  /// \brief The thesis' walk-through viewer (camera, projection, stereo eye spacing, navigation
+  /// bounds and speeds) as a `.sce` scene sets it.
+  Viewer& viewer() { return viewer_; }
+  [[nodiscard]] const Viewer& viewer() const { return viewer_; }
   PerformanceMeter& performance() { return performance_; }
   [[nodiscard]] const PerformanceMeter& performance() const { return performance_; }
 
@@ -174,6 +228,7 @@ class Show {
   PartId internPart(const std::string& name);
 
   std::vector<SceneNode> nodes_;
+  std::vector<std::shared_ptr<const HeightField>> terrains_;
   std::vector<PartState> parts_;
   PartStyle global_;
   mutable std::vector<PartStyle> resolved_;        // cache, one per part
@@ -195,6 +250,8 @@ class Show {
   BackgroundKind backgroundKind_ = BackgroundKind::kColor;
   std::string backgroundImage_;
   EarthSky earthSky_;
+  StereoSettings stereo_;
+  Viewer viewer_;
   PerformanceMeter performance_;
   std::uint64_t frameNumber_ = 0;
 };
@@ -210,6 +267,29 @@ struct ViewTransforms {
 /// \brief LAVA's view (§6.1 "View"): the scene centred and scaled into window bounds -1..1 at the
 /// narrower dimension, seen from `view().perspective` units away on +Z (orthographic at 0).
 ViewTransforms computeView(const Show& show, float aspect);
+
+/// \brief One eye of a stereo pair (thesis §5.1): the eye moved `eyeOffset` window units along
+/// X (negative: left eye) from computeView()'s eye, with an off-axis frustum that keeps the
+/// object's centre plane (z = 0) where the mono view shows it, so the two images agree there
+/// and differ in front of and behind it. Orthographic views are sheared the same way.
+ViewTransforms computeEyeView(const Show& show, float aspect, float eyeOffset);
+
+/// \brief The scene's normalisation (centre and scale into window units, LAVA "View"): what
+/// computeView() puts between the scene and the local matrix.
+Mat4 viewNormalisation(const Show& show);
+
+/// \brief Where the floor and the fake shadow go (LAVA "Environment").
+struct FloorGeometry {
+  Mat4 floor;   ///< maps the floor's square (x and z in -1..1, y = 0) into the world
+  Mat4 shadow;  ///< object coordinates to world, squashed onto the floor (use instead of the model)
+  float y = 0;  ///< the floor's height in the global frame, window units
+};
+
+/// \brief The floor under the object: horizontal in the global frame, `floorPosition` above the
+/// lowest point of the scene's bounding box after the local matrix, centred under the object and
+/// two scene radii from the centre to each side. `shadow` is LAVA's fake shadow: the model
+/// matrix with Y scaled to 0 onto the floor, in the global frame.
+FloorGeometry computeFloor(const Show& show);
 
 /// \brief The colour cube LAVA starts with: six faces, parts "face 1" to "face 6", each with
 /// its own colour, unit half-size, outward normals.

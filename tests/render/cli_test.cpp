@@ -68,6 +68,19 @@ TEST(Cli, DefaultSnapshotGoesToTheOutputFolder) {
   EXPECT_EQ(image->height, 200u);
 }
 
+/// True once the process blocks SIGTERM (its SigBlk mask in /proc), i.e. reads it as an event.
+bool sigtermBlocked(pid_t pid) {
+  std::FILE* f = std::fopen(("/proc/" + std::to_string(pid) + "/status").c_str(), "r");
+  if (!f) return false;
+  char line[256];
+  unsigned long long mask = 0;
+  while (std::fgets(line, sizeof line, f)) {
+    if (std::sscanf(line, "SigBlk: %llx", &mask) == 1) break;
+  }
+  std::fclose(f);
+  return (mask >> (SIGTERM - 1) & 1ULL) != 0;
+}
+
 TEST(Cli, StopsCleanlyOnSigterm) {
   std::string why;
   if (!eglAvailable(why)) GTEST_SKIP() << "no headless EGL here: " << why;
@@ -77,7 +90,10 @@ TEST(Cli, StopsCleanlyOnSigterm) {
   test::Process p = test::Process::start(
       {(test::binaryDir() / "basalt").string(), "run", "--headless", "--snapshot", (dir / "last.png").string()});
   ASSERT_TRUE(p.started());
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  // Signal once basalt handles SIGTERM (blocked, read through its event loop): a fixed sleep
+  // lost the race on a loaded machine and the default action killed it mid-start.
+  for (int i = 0; i < 400 && !sigtermBlocked(p.pid()); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
   p.signal(SIGTERM);
   const auto r = p.wait(std::chrono::seconds(20));
   EXPECT_FALSE(r.timedOut) << "basalt did not stop on SIGTERM";

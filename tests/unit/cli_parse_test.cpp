@@ -64,7 +64,7 @@ TEST(CommandLine, BadInputSaysWhatIsWrong) {
       {{"--size", "0x10"}, "between 1 and 16384"},
       {{"--fps", "0"}, "--fps must be between 1 and 1000"},
       {{"--headless=yes"}, "--headless takes no value"},
-      {{"extra"}, "unexpected argument 'extra'"},
+      {{"a.mdl", "extra"}, "'basalt run' plays one show; 'extra' comes after 'a.mdl'"},
   };
   for (const Case& c : cases) {
     auto r = parse(c.args);

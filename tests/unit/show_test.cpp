@@ -188,7 +188,7 @@ TEST(View, FullScreenFitsTheBoundingSphereInTheNarrowerDimension) {
 }
 
 TEST(Bindings, LavaDialTable) {
-  const Bindings b = Bindings::lavaDefaults();
+  Bindings b = Bindings::lavaDefaults();
   EXPECT_EQ(b.dial(0).action, Action::kRotateX);
   EXPECT_EQ(b.dial(1).action, Action::kRotateY);
   EXPECT_EQ(b.dial(2).action, Action::kRotateZ);

@@ -1,0 +1,200 @@
+// Dial boxes on hidraw, through hidapi's hidraw backend.
+//
+// Hardware: any HID device the kernel gives a hidraw node whose report descriptor maps to dials
+// (devices/hid/dial_decoder.h): the Contour ShuttleXpress and ShuttlePRO (by vendor:product), the
+// Microsoft Surface Dial, Huion dial pads, knobs that report Dial or Wheel, joystick axes. The
+// descriptor is read from sysfs, since hidapi 0.13 cannot return it. Limits: input reports only
+// (no feature reports: a Surface Dial's resolution multiplier stays at the device's default), up
+// to 32 dials and 64 buttons; reads poll every 100 ms for close().
+
+#include <hidapi/hidapi.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "devices/hid/dial_decoder.h"
+#include "devices/hid/hid_backend.h"
+
+namespace basalt::devices {
+
+namespace {
+
+struct HidDeviceCloser {
+  void operator()(hid_device* d) const { hid_close(d); }
+};
+using HidDevicePtr = std::unique_ptr<hid_device, HidDeviceCloser>;
+struct HidEnumerationFree {
+  void operator()(hid_device_info* d) const { hid_free_enumeration(d); }
+};
+using HidEnumerationPtr = std::unique_ptr<hid_device_info, HidEnumerationFree>;
+
+/// hidapi keeps global state; hid_init once per process.
+bool hidInit() {
+  static const bool ok = hid_init() == 0;
+  return ok;
+}
+
+std::string narrow(const wchar_t* w) {
+  std::string out;
+  if (!w) return out;
+  for (; *w; ++w) out += *w < 0x80 ? static_cast<char>(*w) : '?';
+  return out;
+}
+
+std::string hidError(hid_device* d) { return narrow(hid_error(d)); }
+
+std::string busOf(hid_bus_type bus) {
+  switch (bus) {
+    case HID_API_BUS_USB: return "usb";
+    case HID_API_BUS_BLUETOOTH: return "bluetooth";
+    case HID_API_BUS_I2C: return "i2c";
+    case HID_API_BUS_SPI: return "spi";
+    default: return "unknown";
+  }
+}
+
+class HidrawDialBox final : public DialBox {
+ public:
+  HidrawDialBox(DeviceInfo info, std::vector<std::uint8_t> descriptor, DialDecoder decoder, const Clock& clock)
+      : DialBox(std::move(info), decoder.dialCount(), decoder.buttonCount(), true),
+        decoder_(std::move(decoder)),
+        clock_(clock) {
+    setReportDescriptor(std::move(descriptor));
+  }
+  ~HidrawDialBox() override { close(); }
+
+ private:
+  Result<void> doOpen() override {
+    if (!hidInit()) return fail(Errc::kUnavailable, "hidapi could not start", info().path);
+    HidDevicePtr dev(hid_open_path(info().path.c_str()));
+    if (!dev) {
+      const int e = errno;
+      if (e == EACCES || e == EPERM) {
+        return fail(Errc::kPermissionDenied, fmt::format("permission denied; {}", kUdevRuleHint), info().path);
+      }
+      return fail(Errc::kUnavailable, fmt::format("cannot open: {}", hidError(nullptr)), info().path);
+    }
+    decoder_.reset();
+    device_ = std::move(dev);
+    stop_.store(false);
+    reader_ = std::thread([this] { readLoop(); });
+    return {};
+  }
+
+  void doClose() override {
+    stop_.store(true);
+    if (reader_.joinable()) reader_.join();
+    device_.reset();
+  }
+
+  void readLoop() {
+    std::array<std::uint8_t, 4096> buf{};
+    std::array<Event, DialDecoder::kMaxEventsPerReport> events;
+    while (!stop_.load()) {
+      const int n = hid_read_timeout(device_.get(), buf.data(), buf.size(), 100);
+      if (n < 0) {
+        reportLost(Error(Errc::kDeviceLost, fmt::format("read failed: {}", hidError(device_.get())), info().path));
+        return;
+      }
+      if (n == 0) continue;
+      const Nanos now = clock_.now();
+      const auto report = std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n));
+      tapReport(now, report);
+      const std::size_t count = decoder_.decode(report, events);
+      for (std::size_t i = 0; i < count; ++i) {
+        events[i].time = now;
+        emit(events[i]);
+      }
+    }
+  }
+
+  DialDecoder decoder_;
+  const Clock& clock_;
+  HidDevicePtr device_;
+  std::atomic<bool> stop_{false};
+  std::thread reader_;
+};
+
+}  // namespace
+
+Result<std::vector<std::uint8_t>> readHidrawDescriptor(const std::string& devnode) {
+  const std::filesystem::path node(devnode);
+  const std::filesystem::path sys =
+      std::filesystem::path("/sys/class/hidraw") / node.filename() / "device" / "report_descriptor";
+  std::ifstream in(sys, std::ios::binary);
+  if (!in) return fail(Errc::kNotFound, fmt::format("cannot read {}", sys.string()), devnode);
+  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.empty()) return fail(Errc::kParse, "the report descriptor is empty", devnode);
+  return bytes;
+}
+
+Result<std::unique_ptr<DialBox>> openHidrawDialBox(const std::string& devnode, const Clock& clock) {
+  if (!hidInit()) return fail(Errc::kUnavailable, "hidapi could not start", devnode);
+  DeviceInfo info{"", "hid", "unknown", 0, 0, devnode, ""};
+  HidEnumerationPtr list(hid_enumerate(0, 0));
+  for (hid_device_info* d = list.get(); d; d = d->next) {
+    if (devnode != d->path) continue;
+    info.name = narrow(d->product_string);
+    info.vendor = d->vendor_id;
+    info.product = d->product_id;
+    info.serial = narrow(d->serial_number);
+    info.bus = busOf(d->bus_type);
+  }
+  auto descriptor = readHidrawDescriptor(devnode);
+  if (!descriptor) return std::unexpected(descriptor.error());
+  auto decoder = DialDecoder::create(info.vendor, info.product, *descriptor, devnode);
+  if (!decoder) return std::unexpected(decoder.error());
+  if (info.name.empty()) info.name = std::string(dialProfileName(decoder->profile()));
+  return std::unique_ptr<DialBox>(
+      std::make_unique<HidrawDialBox>(std::move(info), std::move(*descriptor), std::move(*decoder), clock));
+}
+
+HidProvider::HidProvider() = default;
+HidProvider::~HidProvider() = default;
+
+std::vector<DeviceCandidate> listPowerMates();  // powermate.cpp
+
+std::vector<DeviceCandidate> HidProvider::enumerate() {
+  std::vector<DeviceCandidate> out;
+  if (hidInit()) {
+    HidEnumerationPtr list(hid_enumerate(0, 0));
+    for (hid_device_info* d = list.get(); d; d = d->next) {
+      DeviceCandidate c;
+      c.kind = DeviceKind::kDialBox;
+      c.info = DeviceInfo{
+          narrow(d->product_string), "hid", busOf(d->bus_type), d->vendor_id, d->product_id, d->path ? d->path : "",
+          narrow(d->serial_number)};
+      auto descriptor = readHidrawDescriptor(c.info.path);
+      if (!descriptor) {
+        c.problem = descriptor.error().describe();
+      } else if (auto decoder = DialDecoder::create(c.info.vendor, c.info.product, *descriptor, c.info.path);
+                 !decoder) {
+        c.problem = fmt::format("not a dial box: {}", decoder.error().message());
+      } else {
+        c.usage = fmt::format("{}: {} dial(s), {} button(s)", dialProfileName(decoder->profile()), decoder->dialCount(),
+                              decoder->buttonCount());
+        if (::access(c.info.path.c_str(), R_OK | W_OK) != 0) {
+          c.problem = fmt::format("{}; {}", systemErrorText("cannot open", errno), kUdevRuleHint);
+        }
+      }
+      out.push_back(std::move(c));
+    }
+  }
+  for (DeviceCandidate& c : listPowerMates()) out.push_back(std::move(c));
+  return out;
+}
+
+Result<std::unique_ptr<DialBox>> HidProvider::openDialBox(const DeviceCandidate& candidate, const DeviceRequest&,
+                                                          const Clock& clock) {
+  return candidate.info.path.starts_with("usb:") ? openPowerMate(candidate.info.path, clock)
+                                                 : openHidrawDialBox(candidate.info.path, clock);
+}
+
+}  // namespace basalt::devices

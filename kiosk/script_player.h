@@ -1,0 +1,103 @@
+#pragma once
+
+/// \file
+/// \brief Plays a LAVA script in the frame loop (`basalt run show.mdl`, as `lava -file
+/// show.mdl`): a FrameParticipant that steps the interpreter one frame at a time, and the
+/// script::Host that gives scripts files, images and the picture.
+///
+/// The script runs up to its first `draw` before frame 0 is drawn; after that it runs in each
+/// frame's afterDraw(), while the frame just drawn is still in the framebuffer, up to the next
+/// `draw`. So `save_image` and `end_jitter` read exactly the picture the script drew last, and a
+/// `quit` makes the frame just drawn the last one.
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "kiosk/frame_loop.h"
+#include "render/renderer.h"
+#include "runtime/image.h"
+#include "runtime/script/host.h"
+#include "runtime/script/interpreter.h"
+
+namespace basalt::kiosk {
+
+struct ScriptPlayerOptions {
+  std::filesystem::path outputDir = "out";  ///< where save_image writes
+  /// The file of a bare `save_image`; relative names are in outputDir. LAVA's was "ras.im32".
+  std::filesystem::path saveImage = "ras.im32";
+  bool quitEndsRun = true;  ///< `quit` ends the run (the script was given on the command line)
+};
+
+/// \brief Runs one script against the Show of a frame loop.
+///
+/// Threading: the frame loop's thread, with the GL context current (textures are uploaded and
+/// the framebuffer read back here).
+class ScriptPlayer final : public FrameParticipant, public script::Host {
+ public:
+  ScriptPlayer(script::Interpreter interpreter, runtime::Show& show, render::Renderer& renderer,
+               ScriptPlayerOptions options);
+
+  /// \brief Where messages about the script go (errors, warnings, notes), one at a time.
+  void setReporter(const script::Interpreter::Reporter& reporter);
+
+  // FrameParticipant
+  Result<void> beforeDraw(const FrameContext& frame) override;
+  void adjustView(const FrameContext& frame, runtime::ViewTransforms& view, render::Size size) override;
+  Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
+  [[nodiscard]] bool wantsStop() const override { return stop_; }
+
+  // script::Host
+  [[nodiscard]] Result<void> loadObject(const std::filesystem::path& file, runtime::Show& show) override;
+  [[nodiscard]] Result<void> loadTexture(const std::filesystem::path& file, const std::string& name) override;
+  [[nodiscard]] Result<void> saveImage(std::string_view name) override;
+  [[nodiscard]] Result<void> accumulateJitterPass(int pass, int passes) override;
+  [[nodiscard]] Result<void> tv(const script::TvRequest& request) override;
+  [[nodiscard]] bool renders(script::Feature feature) const override;
+
+  [[nodiscard]] const script::Interpreter& interpreter() const { return interpreter_; }
+  /// \brief Files save_image wrote, in order.
+  [[nodiscard]] const std::vector<std::filesystem::path>& imagesWritten() const { return written_; }
+  /// \brief How the frame being made is drawn: the step that ended it.
+  [[nodiscard]] const script::StepResult& currentStep() const { return step_; }
+
+ private:
+  void runStep();
+  Result<const Image*> currentPicture();
+  void warn(std::string message);
+
+  script::Interpreter interpreter_;
+  runtime::Show& show_;
+  render::Renderer& renderer_;
+  ScriptPlayerOptions options_;
+  script::Interpreter::Reporter reporter_;
+
+  script::StepResult step_;
+  bool started_ = false;
+  bool stop_ = false;
+  render::Output* output_ = nullptr;  // set only while afterDraw() runs the script
+  Image frame_;                       // the frame just drawn, read back on demand
+  bool frameRead_ = false;
+  std::vector<std::uint32_t> jitterSum_;  // per channel, sized on the first pass
+  Image jitterAverage_;
+  bool jitterReady_ = false;  // jitterAverage_ is the current picture (until the next draw)
+  bool sunRasterWarned_ = false;
+  std::vector<std::filesystem::path> written_;
+};
+
+/// \brief Whether `path` names a LAVA script (.mdl, any case).
+bool isScriptFile(const std::filesystem::path& path);
+/// \brief Reads and parses a script, printing what parsing found wrong (the run goes on).
+Result<script::Interpreter> loadScript(const std::filesystem::path& path);
+/// \brief Whether the script has a `quit` (a batch job rather than a show that plays on).
+bool scriptQuits(const script::Program& program);
+/// \brief Prints one message about a script: "basalt: error: show.mdl:12: ...".
+void printScriptDiagnostic(const script::Diagnostic& diagnostic);
+/// \brief Prints what a script did: frames drawn, problems reported, images written.
+void printScriptSummary(const ScriptPlayer& player);
+/// \brief Writes a saved model (or any text) to `path`, atomically.
+Result<void> writeSavedModel(const std::filesystem::path& path, std::string_view text);
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,495 @@
+#include "kiosk/show_director.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <fmt/std.h>
+
+#include "runtime/log.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Director, "kiosk");
+
+namespace {
+
+constexpr Nanos kSaveEvery = std::chrono::seconds(2);
+constexpr Nanos kMaxRetry = std::chrono::seconds(30);
+
+}  // namespace
+
+ShowDirector::ShowDirector(DirectorContext context) : context_(context) { context_.board.setShowClock(context_.clock); }
+
+ShowDirector::~ShowDirector() {
+  if (loader_.joinable()) loader_.join();
+  if (textureLoader_.joinable()) textureLoader_.join();
+  if (show_) {
+    for (DeviceSlot& slot : show_->devices) {
+      if (slot.dialBox) slot.dialBox->close();
+    }
+  }
+  if (policy_ && context_.state) {
+    context_.state->save(policy_->resumePoint(context_.clock.now()));
+    context_.state->flush();
+  }
+}
+
+void ShowDirector::install(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume) {
+  takeOver(std::move(show), now, resume);
+  if (resume && policy_->current().item && policy_->current().item->name == resume->item &&
+      resume->position > Nanos{0}) {
+    log::info(kLogDirector, "resuming '{}' at {:.1f} s, where the show was before it stopped", resume->item,
+              toSeconds(resume->position));
+  }
+}
+
+void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume) {
+  // The old show's devices stop; their queued events are stale.
+  if (show_) {
+    for (DeviceSlot& slot : show_->devices) {
+      if (slot.dialBox) slot.dialBox->close();
+    }
+    for (const LoadedTexture& t : show_->textures) context_.renderer.textures().remove(t.name);
+  }
+  Event stale;
+  while (context_.events.pop(stale)) {
+  }
+  player_ = nullptr;
+  std::unique_ptr<LoadedShow> old = std::move(show_);
+  show_ = std::move(show);
+  reportedFailures_.clear();
+  const WallTime wall = context_.clock.wallNow();
+  for (DeviceSlot& slot : show_->devices) {
+    slot.since = wall;
+    slot.nextAttempt = now;
+  }
+  for (LoadedTexture& t : show_->textures) {
+    if (t.image) {
+      if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
+        log::warn(kLogDirector, "texture '{}': {}", t.name, r.error().describe());
+      }
+    }
+    t.live = false;
+  }
+  ++showGeneration_;
+  // Images not read yet (start-up) are read once the first frame is on screen, so that decoding
+  // them never delays it.
+  texturesPending_ = true;
+  policy_ = std::make_unique<KioskPolicy>(show_->manifest, show_->schedule);
+  scheduleForStatus_ = show_->schedule ? std::make_shared<const Schedule>(*show_->schedule) : nullptr;
+  policy_->start(now, wall, resume);
+  appliedGeneration_ = 0;
+  applyProgramme(now);
+  publishDevices();
+  publishStreams();
+  old.reset();  // after the new show is on: its players and devices go now
+}
+
+void ShowDirector::loadTexturesInBackground() {
+  std::vector<std::pair<std::string, std::filesystem::path>> wanted;
+  for (const LoadedTexture& t : show_->textures) {
+    if (!t.image && !t.imageFile.empty()) wanted.emplace_back(t.name, t.imageFile);
+  }
+  if (wanted.empty()) return;
+  if (textureLoader_.joinable()) textureLoader_.join();
+  textureLoader_ = std::thread([this, wanted = std::move(wanted), generation = showGeneration_] {
+    std::vector<std::pair<std::string, std::optional<Image>>> images;
+    for (const auto& [name, file] : wanted) images.emplace_back(name, readTextureImage(name, file));
+    {
+      std::lock_guard lock(reloadMutex_);
+      textures_ = std::move(images);
+      texturesFor_ = generation;
+      texturesReady_ = true;
+    }
+    context_.loop.wake();
+  });
+}
+
+void ShowDirector::pollTextures() {
+  std::vector<std::pair<std::string, std::optional<Image>>> images;
+  {
+    std::lock_guard lock(reloadMutex_);
+    if (!texturesReady_) return;
+    texturesReady_ = false;
+    if (texturesFor_ != showGeneration_) return;  // read for a show that has been replaced since
+    images = std::move(textures_);
+  }
+  for (auto& [name, image] : images) {
+    if (!image) continue;
+    for (LoadedTexture& t : show_->textures) {
+      if (t.name != name) continue;
+      t.image = std::move(*image);
+      if (!t.live) {
+        if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
+          log::warn(kLogDirector, "texture '{}': {}", t.name, r.error().describe());
+        }
+      }
+    }
+  }
+}
+
+void ShowDirector::requestReload() {
+  if (!show_ || show_->manifest.file.empty()) {
+    log::info(kLogDirector, "reload asked, but the built-in default show has no manifest to re-read");
+    return;
+  }
+  if (loading_) {
+    log::info(kLogDirector, "reload asked while one is under way; the newer manifest is read when it ends");
+    return;
+  }
+  if (loader_.joinable()) loader_.join();
+  loading_ = true;
+  if (context_.supervisor) context_.supervisor->reloading();
+  log::info(kLogDirector, "reloading {}; the current show plays on until the new one is ready", show_->manifest.file);
+  const std::filesystem::path file = show_->manifest.file;
+  loader_ = std::thread([this, file] {
+    Diagnostics diagnostics;
+    auto loaded = readAndLoadShow(file, context_.clock, diagnostics);
+    {
+      std::lock_guard lock(reloadMutex_);
+      reloadReady_ = true;
+      if (loaded) {
+        reloaded_ = std::move(*loaded);
+        for (const Diagnostic& d : diagnostics.items()) {
+          if (d.severity == Severity::kWarning) log::warn(kLogDirector, "{}", d.format());
+        }
+      } else {
+        reloadError_ = loaded.error().describe();
+        for (const Diagnostic& d : diagnostics.items()) {
+          if (d.severity == Severity::kError) log::error(kLogDirector, "{}", d.format());
+        }
+      }
+    }
+    context_.loop.wake();
+  });
+}
+
+void ShowDirector::pollReload(const FrameContext& frame) {
+  if (!loading_) return;
+  std::unique_ptr<LoadedShow> next;
+  std::string error;
+  {
+    std::lock_guard lock(reloadMutex_);
+    if (!reloadReady_) return;
+    reloadReady_ = false;
+    next = std::move(reloaded_);
+    error = std::move(reloadError_);
+  }
+  loading_ = false;
+  loader_.join();
+  const Nanos now = frame.time;
+  if (!next) {
+    ++reloadsFailed_;
+    log::error(kLogDirector, "reload failed: {}; the current show plays on", error);
+    context_.board.noteReload(false, "failed: " + error);
+    if (context_.supervisor) context_.supervisor->reloaded("reload failed: " + error + "; " + policy_->describe());
+    return;
+  }
+  const auto resume = policy_ ? std::optional<ResumePoint>(policy_->resumePoint(now)) : std::nullopt;
+  takeOver(std::move(next), now, resume);
+  ++reloadsApplied_;
+  lastReloadFrame_ = frame.frame;
+  context_.board.noteReloadApplied(frame.frame);
+  context_.board.noteReload(true, fmt::format("reloaded at frame {}", frame.frame));
+  log::info(kLogDirector, "reloaded {}: {}", show_->manifest.file, policy_->describe());
+  if (context_.supervisor) context_.supervisor->reloaded(policy_->describe());
+}
+
+void ShowDirector::handleControls(const FrameContext& frame) {
+  const Nanos now = frame.time;
+  ControlRequest request;
+  while (context_.board.controls().pop(request)) {
+    auto& reply = *request.reply;
+    switch (request.kind) {
+      case ControlKind::kNext:
+      case ControlKind::kPrevious: {
+        const bool moved = request.kind == ControlKind::kNext ? policy_->next(now) : policy_->previous(now);
+        if (moved) {
+          applyProgramme(now);
+          reply.answer(200, policy_->describe());
+        } else {
+          reply.answer(409, "nothing to move to: " + policy_->describe());
+        }
+        break;
+      }
+      case ControlKind::kReload:
+        if (!show_ || show_->manifest.file.empty()) {
+          reply.answer(409, "the built-in default show has no manifest to reload");
+        } else {
+          requestReload();
+          reply.answer(202, "reloading " + show_->manifest.file.string());
+        }
+        break;
+      case ControlKind::kRunCommand: {
+        auto out = runScriptCommand(request.argument, context_.show);
+        if (out) {
+          reply.answer(200, *out);
+        } else {
+          reply.answer(out.error().code() == Errc::kUnsupported ? 501 : 400, out.error().describe());
+        }
+        break;
+      }
+      case ControlKind::kRestartDevice: {
+        auto it = std::find_if(show_->devices.begin(), show_->devices.end(),
+                               [&](const DeviceSlot& s) { return s.spec.name == request.argument; });
+        if (it == show_->devices.end()) {
+          reply.answer(404, fmt::format("no device '{}' in this show", request.argument));
+        } else if (!it->dialBox) {
+          reply.answer(409, fmt::format("'{}' cannot be restarted: {}", request.argument, it->unavailable));
+        } else {
+          it->dialBox->close();
+          const auto id = static_cast<DeviceId>(it - show_->devices.begin() + 1);
+          auto opened = it->dialBox->open(id, context_.events);
+          it->backoff = std::chrono::seconds(1);
+          it->nextAttempt = now + it->backoff;
+          it->message = opened ? std::string() : opened.error().message();
+          log::info(kLogDirector, "device '{}' restarted by the control server: {}", request.argument,
+                    opened ? "live" : it->message);
+          reply.answer(opened ? 200 : 500,
+                       opened ? fmt::format("'{}' restarted", request.argument) : opened.error().describe());
+        }
+        break;
+      }
+    }
+  }
+}
+
+void ShowDirector::serviceDevices(Nanos now) {
+  bool changed = false;
+  const WallTime wall = context_.clock.wallNow();
+  for (std::size_t i = 0; i < show_->devices.size(); ++i) {
+    DeviceSlot& slot = show_->devices[i];
+    if (!slot.dialBox) continue;
+    devices::DialBox& box = *slot.dialBox;
+    if (box.state() != devices::DeviceState::kLive && now >= slot.nextAttempt) {
+      auto opened = box.open(static_cast<DeviceId>(i + 1), context_.events);
+      if (opened) {
+        slot.backoff = std::chrono::seconds(1);
+        slot.message.clear();
+      } else {
+        if (slot.message != opened.error().message()) {
+          log::warn(kLogDirector, "device '{}' ({}): {}; retrying every {} s at most", slot.spec.name,
+                    deviceBackendName(slot.spec.backend), opened.error().describe(), toSeconds(kMaxRetry));
+        }
+        slot.message = opened.error().message();
+        slot.nextAttempt = now + slot.backoff;
+        slot.backoff = std::min(slot.backoff * 2, kMaxRetry);
+      }
+    }
+    box.service(now);
+    if (box.state() != slot.state) {
+      if (slot.state == devices::DeviceState::kLive) {
+        log::warn(kLogDirector, "device '{}' is {}; its bindings are quiet until it comes back", slot.spec.name,
+                  devices::deviceStateName(box.state()));
+        slot.nextAttempt = now + slot.backoff;
+      } else if (box.state() == devices::DeviceState::kLive) {
+        log::info(kLogDirector, "device '{}' is live ({})", slot.spec.name, box.info().name);
+      }
+      slot.state = box.state();
+      slot.since = wall;
+      changed = true;
+    }
+  }
+  if (changed) publishDevices();
+}
+
+void ShowDirector::applyInput(Nanos until) {
+  const Nanos now = until;
+  context_.events.drainWhile([until](const Event& e) { return e.time <= until; },
+                             [this, now](Event e) {
+                               if (e.device == 0 || e.device > show_->devices.size()) return;
+                               if (e.kind != EventKind::kDialDelta && e.kind != EventKind::kButton &&
+                                   e.kind != EventKind::kDialAbsolute && e.kind != EventKind::kShuttle) {
+                                 return;
+                               }
+                               // A visitor touched something: wake the exhibit, and count as activity.
+                               if (policy_->noteInput(now)) applyProgramme(now);
+                               if (!player_) return;
+                               DeviceSlot& slot = show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
+                               if (e.kind == EventKind::kButton) {
+                                 if (e.value < 0.5 || e.index >= slot.buttons.size()) return;
+                                 switch (slot.buttons[e.index]) {
+                                   case KioskAction::kNextItem:
+                                     if (policy_->next(now)) applyProgramme(now);
+                                     break;
+                                   case KioskAction::kPreviousItem:
+                                     if (policy_->previous(now)) applyProgramme(now);
+                                     break;
+                                   case KioskAction::kResetView: context_.show.resetTransforms(); break;
+                                   case KioskAction::kNone: break;
+                                 }
+                                 return;
+                               }
+                               slot.dials.apply(e, context_.show);
+                             });
+}
+
+void ShowDirector::applyProgramme(Nanos now) {
+  // An item that fails moves the policy on; at most one round of the list per call.
+  for (std::size_t attempt = 0; attempt < 64; ++attempt) {
+    const Programme& p = policy_->current();
+    if (p.generation == appliedGeneration_) return;
+    appliedGeneration_ = p.generation;
+    player_ = nullptr;
+    const bool wantOff = p.display == DisplayState::kOff;
+    if (wantOff && displayOn_ && !displayOffUnsupported_) {
+      if (auto r = context_.output.setDisplayPower(false); r) {
+        displayOn_ = false;
+      } else {
+        displayOffUnsupported_ = true;
+        log::warn(kLogDirector, "cannot switch the display off ({}); showing black instead", r.error().message());
+      }
+    } else if (!wantOff && !displayOn_) {
+      if (auto r = context_.output.setDisplayPower(true); !r) {
+        log::error(kLogDirector, "cannot switch the display back on: {}", r.error().describe());
+      }
+      displayOn_ = true;
+    }
+    if (!p.item || p.display != DisplayState::kOn) {
+      context_.show = runtime::Show();
+    } else {
+      const std::string key = entryKey(p.item->entry);
+      const auto found = show_->players.find(key);
+      Result<void> started = fail(Errc::kInternal, "no player");
+      if (found == show_->players.end()) {
+        const auto why = show_->unplayable.find(key);
+        started = std::unexpected(why != show_->unplayable.end() ? why->second
+                                                                 : Error(Errc::kInternal, "item was not prepared"));
+      } else {
+        started = found->second->start(context_.show, now - p.itemStart, context_.fps);
+      }
+      if (!started) {
+        if (reportedFailures_.insert(key).second) {
+          log::error(kLogDirector, "'{}' cannot play: {}; moving on", p.item->name, started.error().describe());
+        }
+        policy_->itemFailed(now);
+        continue;
+      }
+      player_ = found->second.get();
+    }
+    log::info(kLogDirector, "{}", policy_->describe());
+    if (context_.supervisor) context_.supervisor->status(policy_->describe());
+    publishShow();
+    saveState(now);
+  }
+}
+
+void ShowDirector::updateStreams(Nanos now) {
+  bool changed = false;
+  for (LoadedTexture& t : show_->textures) {
+    if (!t.stream) continue;
+    const bool live = t.stream->update(now, context_.renderer.textures(), t.name);
+    if (live == t.live) continue;
+    t.live = live;
+    changed = true;
+    if (!live && t.image) {
+      if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
+        log::warn(kLogDirector, "texture '{}': {}", t.name, r.error().describe());
+      }
+    }
+  }
+  if (changed) publishStreams();
+}
+
+void ShowDirector::saveState(Nanos now) {
+  lastSave_ = now;
+  if (context_.state && show_->manifest.kiosk.resume) context_.state->save(policy_->resumePoint(now));
+}
+
+Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
+  pollReload(frame);
+  pollTextures();
+  handleControls(frame);
+  const Nanos now = frame.time;
+  serviceDevices(now);
+  applyInput(now);
+  if (policy_->update(now, context_.clock.wallNow())) applyProgramme(now);
+  if (player_) {
+    if (auto r = player_->beforeDraw(frame, context_.show); !r) {
+      log::error(kLogDirector, "'{}' stopped: {}; moving on", policy_->current().item->name, r.error().describe());
+      policy_->itemFailed(now);
+      applyProgramme(now);
+    } else if (player_->ended()) {
+      policy_->itemEnded(now);
+      applyProgramme(now);
+    }
+  }
+  updateStreams(now);
+  if (now - lastSave_ >= kSaveEvery) saveState(now);
+  return {};
+}
+
+Result<void> ShowDirector::afterDraw(const FrameContext& /*frame*/, render::Output& output) {
+  std::shared_ptr<SnapshotRequest> request;
+  if (!context_.board.snapshotRequests().pop(request)) return {};
+  Image image;
+  const auto read = output.readBack(image);
+  do {
+    if (read) {
+      request->answer(true, image, {});
+    } else {
+      request->answer(false, {}, read.error().describe());
+    }
+  } while (context_.board.snapshotRequests().pop(request));
+  return {};
+}
+
+void ShowDirector::afterPresent(const FrameContext& /*frame*/) {
+  if (texturesPending_) {
+    texturesPending_ = false;
+    loadTexturesInBackground();
+  }
+}
+
+void ShowDirector::publishShow() {
+  const Programme& p = policy_->current();
+  ShowStatus s;
+  s.name = show_->manifest.name;
+  s.manifest = show_->manifest.file.string();
+  s.output = context_.output.describe();
+  s.open = p.mode != KioskMode::kClosed;
+  s.mode = std::string(kioskModeName(p.mode));
+  s.display = std::string(displayStateName(p.display));
+  s.item = p.item ? p.item->name : std::string();
+  s.index = p.item ? p.index + 1 : 0;
+  s.count = p.count;
+  s.description = policy_->describe();
+  s.schedule = scheduleForStatus_;
+  context_.board.publishShow(std::move(s));
+}
+
+void ShowDirector::publishDevices() {
+  std::vector<DeviceStatus> out;
+  for (const DeviceSlot& slot : show_->devices) {
+    DeviceStatus d;
+    d.name = slot.spec.name;
+    d.kind = std::string(deviceKindName(slot.spec.kind));
+    d.backend = std::string(deviceBackendName(slot.spec.backend));
+    d.state = slot.dialBox ? std::string(devices::deviceStateName(slot.dialBox->state())) : "absent";
+    d.message = slot.message.empty() && slot.dialBox ? slot.dialBox->info().name : slot.message;
+    d.since = slot.since;
+    out.push_back(std::move(d));
+  }
+  context_.board.publishDevices(std::move(out));
+}
+
+void ShowDirector::publishStreams() {
+  std::vector<StreamStatus> out;
+  const WallTime wall = context_.clock.wallNow();
+  for (const LoadedTexture& t : show_->textures) {
+    if (t.source.empty()) continue;
+    const MediaSpec* media = show_->manifest.findMedia(t.source);
+    if (!media || media->kind == MediaKind::kImage) continue;
+    StreamStatus s;
+    s.name = t.source;
+    s.kind = std::string(mediaKindName(media->kind));
+    s.state = t.live ? "playing" : (t.stream ? "waiting" : "absent");
+    s.message = t.stream ? t.stream->describe() : t.streamState;
+    if (!t.live) s.message += t.image ? "; showing the fallback image" : "; showing black";
+    s.since = wall;
+    out.push_back(std::move(s));
+  }
+  context_.board.publishStreams(std::move(out));
+}
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,121 @@
+#pragma once
+
+/// \file
+/// \brief The show director: the frame participant that runs a loaded show. Each frame it takes
+/// a reloaded show over when one is ready, answers control requests, services the devices,
+/// applies their input (visitor activity, dial bindings, button actions), lets the kiosk policy
+/// decide what plays and switches items, display power and textures accordingly, feeds the
+/// playing item its frame, and saves where the show is.
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <thread>
+
+#include "kiosk/frame_loop.h"
+#include "kiosk/kiosk_policy.h"
+#include "kiosk/show_loader.h"
+#include "kiosk/state_store.h"
+#include "kiosk/status_board.h"
+#include "kiosk/supervisor.h"
+#include "render/output.h"
+#include "render/renderer.h"
+#include "runtime/bounded_queue.h"
+#include "runtime/event.h"
+#include "runtime/event_loop.h"
+#include "runtime/show/show.h"
+
+namespace basalt::kiosk {
+
+/// \brief What the director works with; everything is borrowed and outlives it.
+struct DirectorContext {
+  const Clock& clock;
+  runtime::EventLoop& loop;
+  runtime::Show& show;
+  render::Renderer& renderer;
+  render::Output& output;
+  StatusBoard& board;
+  BoundedQueue<Event>& events;
+  Supervisor* supervisor = nullptr;  ///< null when not supervised
+  StateStore* state = nullptr;       ///< null when resuming is off
+  double fps = 60;
+};
+
+/// \brief Runs a show on the frame loop.
+///
+/// Threading: everything on the frame loop's thread, except the reload, which reads and loads
+/// the manifest on a thread of its own and hands the result over through `reloadMutex_`.
+class ShowDirector final : public FrameParticipant {
+ public:
+  explicit ShowDirector(DirectorContext context);
+  ~ShowDirector() override;
+  ShowDirector(const ShowDirector&) = delete;
+  ShowDirector& operator=(const ShowDirector&) = delete;
+
+  /// \brief Installs the first show at `now`, resuming at `resume` when it still fits.
+  void install(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume);
+  /// \brief Re-reads the manifest on a loader thread; the current show plays on until the new
+  /// one is ready, and stays when the new one has errors.
+  void requestReload();
+
+  Result<void> beforeDraw(const FrameContext& frame) override;
+  Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
+  void afterPresent(const FrameContext& frame) override;
+  [[nodiscard]] bool wantsStop() const override { return context_.output.closeRequested(); }
+
+  [[nodiscard]] const KioskPolicy* policy() const { return policy_.get(); }
+  [[nodiscard]] const LoadedShow* loaded() const { return show_.get(); }
+  [[nodiscard]] std::int64_t reloadsApplied() const { return reloadsApplied_; }
+  [[nodiscard]] std::int64_t reloadsFailed() const { return reloadsFailed_; }
+  /// \brief The frame in which the last reload took over (-1 when none did).
+  [[nodiscard]] std::int64_t lastReloadFrame() const { return lastReloadFrame_; }
+
+ private:
+  void takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume);
+  void pollReload(const FrameContext& frame);
+  void loadTexturesInBackground();
+  void pollTextures();
+  void handleControls(const FrameContext& frame);
+  void serviceDevices(Nanos now);
+  void applyInput(Nanos until);
+  void applyProgramme(Nanos now);
+  void updateStreams(Nanos now);
+  void saveState(Nanos now);
+  void publishShow();
+  void publishDevices();
+  void publishStreams();
+
+  DirectorContext context_;
+  std::unique_ptr<LoadedShow> show_;
+  std::unique_ptr<KioskPolicy> policy_;
+  std::shared_ptr<const Schedule> scheduleForStatus_;
+  ItemPlayer* player_ = nullptr;  // the playing item's player, owned by show_
+  std::uint64_t appliedGeneration_ = 0;
+  bool displayOn_ = true;
+  bool displayOffUnsupported_ = false;
+  std::set<std::string> reportedFailures_;
+  Nanos lastSave_{0};
+
+  // Reload hand-over: the loader thread writes, the frame loop reads.
+  std::mutex reloadMutex_;
+  std::thread loader_;
+  bool loading_ = false;                  // frame loop only
+  bool reloadReady_ = false;              // guarded by reloadMutex_
+  std::unique_ptr<LoadedShow> reloaded_;  // guarded by reloadMutex_
+  std::string reloadError_;               // guarded by reloadMutex_
+  // Texture images read in the background after start-up, handed over the same way.
+  std::thread textureLoader_;
+  std::uint64_t showGeneration_ = 0;                                    // frame loop only
+  bool texturesPending_ = false;                                        // frame loop only
+  bool texturesReady_ = false;                                          // guarded by reloadMutex_
+  std::uint64_t texturesFor_ = 0;                                       // guarded by reloadMutex_
+  std::vector<std::pair<std::string, std::optional<Image>>> textures_;  // guarded by reloadMutex_
+  std::int64_t reloadsApplied_ = 0;
+  std::int64_t reloadsFailed_ = 0;
+  std::int64_t lastReloadFrame_ = -1;
+};
+
+}  // namespace basalt::kiosk

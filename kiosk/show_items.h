@@ -1,0 +1,62 @@
+#pragma once
+
+/// \file
+/// \brief What plays one item of a show (its entry, a playlist item, the attract loop, the
+/// standby show): the seam through which scripts, scenes, models and movies plug into the kiosk.
+///
+/// Built in: "default" (LAVA's start-up cube) and "black". A reader for another kind of item
+/// registers a factory with setItemFactory() (the LAVA script interpreter for .mdl, the scene
+/// and model loaders for .sce/.obj/.off, the movie player for movies); until one is registered,
+/// such an item fails with a message that says so, and the kiosk moves on (DESIGN.md §8: the
+/// show goes on).
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "kiosk/frame_loop.h"
+#include "kiosk/manifest.h"
+#include "runtime/error.h"
+#include "runtime/show/show.h"
+
+namespace basalt::kiosk {
+
+/// \brief Plays one item into the Show.
+///
+/// Threading: made on the show loader's thread (files are read there), then used on the frame
+/// loop's thread only.
+class ItemPlayer {
+ public:
+  virtual ~ItemPlayer() = default;
+  /// \brief Replaces what the show holds with this item, `position` into it (a resumed show).
+  /// Must be quick: the frame it is called in must still be on time.
+  [[nodiscard]] virtual Result<void> start(runtime::Show& show, Nanos position, double fps) = 0;
+  /// \brief Every frame before drawing, while the item plays: a script runs to its next
+  /// `draw`; a movie picks its frame. An error ends the item.
+  [[nodiscard]] virtual Result<void> beforeDraw(const FrameContext& frame, runtime::Show& show) {
+    (void)frame;
+    (void)show;
+    return {};
+  }
+  /// \brief True once the item has ended by itself (a script's quit or end, a movie's end).
+  [[nodiscard]] virtual bool ended() const { return false; }
+};
+
+/// \brief Makes the player of an entry. Called off the frame loop's thread.
+using ItemFactory = std::function<Result<std::unique_ptr<ItemPlayer>>(const EntrySpec& entry, const Manifest& show)>;
+
+/// \brief Registers the factory for a kind of entry (call before the first show loads).
+void setItemFactory(EntryKind kind, ItemFactory factory);
+
+/// \brief The player of `entry`, or why it cannot be played in this build.
+[[nodiscard]] Result<std::unique_ptr<ItemPlayer>> prepareItem(const EntrySpec& entry, const Manifest& show);
+
+/// \brief Runs one LAVA script command on the show (the control server's "run a command").
+using CommandRunner = std::function<Result<std::string>(std::string_view command, runtime::Show& show)>;
+/// \brief Registers the script interpreter's command runner (call before the first show loads).
+void setCommandRunner(CommandRunner runner);
+/// \brief Runs `command`, or says that this build cannot.
+[[nodiscard]] Result<std::string> runScriptCommand(std::string_view command, runtime::Show& show);
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,218 @@
+#include "kiosk/video_streams.h"
+
+#include <charconv>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <fmt/std.h>
+
+#include "runtime/log.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Kiosk, "kiosk");
+
+Result<std::pair<std::string, std::filesystem::path>> parseMovieOption(std::string_view text) {
+  const auto eq = text.find('=');
+  if (eq == std::string_view::npos || eq == 0 || eq + 1 == text.size()) {
+    return fail(Errc::kInvalidArgument,
+                fmt::format("--movie needs PART=FILE (the part that shows the movie, and the movie), not '{}'", text));
+  }
+  return std::pair{std::string(text.substr(0, eq)), std::filesystem::path(text.substr(eq + 1))};
+}
+
+Result<std::pair<std::string, ZoomSpec>> parseZoomOption(std::string_view text) {
+  ZoomSpec zoom;
+  const auto bad = [&] {
+    return fail(Errc::kInvalidArgument,
+                fmt::format("--zoom needs PART[=SCALE][@X,Y] (e.g. movie=0.5@10,10), not '{}'", text));
+  };
+  std::string_view rest = text;
+  std::string_view at;
+  if (const auto a = rest.find('@'); a != std::string_view::npos) {
+    at = rest.substr(a + 1);
+    rest = rest.substr(0, a);
+  }
+  std::string name(rest);
+  if (const auto eq = rest.find('='); eq != std::string_view::npos) {
+    name = std::string(rest.substr(0, eq));
+    const std::string_view s = rest.substr(eq + 1);
+    const auto r = std::from_chars(s.data(), s.data() + s.size(), zoom.scale);
+    if (r.ec != std::errc{} || r.ptr != s.data() + s.size() || !(zoom.scale > 0 && zoom.scale <= 16)) return bad();
+  }
+  if (!at.empty()) {
+    const auto comma = at.find(',');
+    if (comma == std::string_view::npos) return bad();
+    const std::string_view xs = at.substr(0, comma), ys = at.substr(comma + 1);
+    const auto rx = std::from_chars(xs.data(), xs.data() + xs.size(), zoom.x);
+    const auto ry = std::from_chars(ys.data(), ys.data() + ys.size(), zoom.y);
+    if (rx.ec != std::errc{} || ry.ec != std::errc{} || rx.ptr != xs.data() + xs.size() ||
+        ry.ptr != ys.data() + ys.size() || !std::isfinite(zoom.x) || !std::isfinite(zoom.y)) {
+      return bad();
+    }
+  }
+  if (name.empty()) return bad();
+  return std::pair{name, zoom};
+}
+
+struct VideoStreams::Stream {
+  MovieStreamSpec spec;
+  std::unique_ptr<media::MoviePlayer> player;
+  std::unique_ptr<render::StreamTexture> texture;
+  media::MovieState lastState = media::MovieState::kEmpty;
+  render::PictureRect zoomRect{};
+  bool zoomPlaced = false;
+};
+
+VideoStreams::VideoStreams(render::Renderer& renderer, bool manualClock)
+    : renderer_(renderer), manualClock_(manualClock) {}
+
+VideoStreams::~VideoStreams() {
+  for (const auto& s : streams_) renderer_.textures().remove(s->spec.name);
+}
+
+Result<std::unique_ptr<VideoStreams>> VideoStreams::create(const std::vector<MovieStreamSpec>& specs,
+                                                           runtime::Show& show, render::Renderer& renderer,
+                                                           bool manualClock) {
+  std::unique_ptr<VideoStreams> v(new VideoStreams(renderer, manualClock));
+  for (const MovieStreamSpec& spec : specs) {
+    auto stream = std::make_unique<Stream>();
+    stream->spec = spec;
+    media::MoviePlayerOptions options;
+    options.name = fmt::format("movie '{}'", spec.name);
+    options.audio = spec.audio;
+    auto player = media::MoviePlayer::create(options);
+    if (!player) return std::unexpected(player.error());
+    stream->player = std::move(*player);
+    auto texture = render::StreamTexture::create(spec.name);
+    if (!texture) return std::unexpected(texture.error());
+    stream->texture = std::move(*texture);
+    stream->texture->publish(renderer.textures());
+    if (auto r = stream->player->loadPlaylist(spec.files); !r) {
+      // A missing file: say so and show the fallback; the show goes on.
+      log::error(kLogKiosk, "{}: {}; showing the fallback texture", options.name, r.error().describe());
+    } else {
+      stream->player->setRepeat(spec.repeat);
+      stream->player->play();
+    }
+    if (auto part = show.findPart(spec.name)) {
+      show.setPartTexture(*part, spec.name);
+      show.texture().source = runtime::TextureSource::kVideo;  // LAVA's texture.switch = video
+    } else if (!spec.zoom) {
+      log::warn(kLogKiosk,
+                "movie '{}': the show has no part of that name; the movie is a texture named '{}' for later use",
+                spec.name, spec.name);
+    }
+    v->streams_.push_back(std::move(stream));
+  }
+  if (std::any_of(specs.begin(), specs.end(), [](const MovieStreamSpec& s) { return s.zoom.has_value(); })) {
+    auto overlay = render::PictureOverlay::create();
+    if (!overlay) return std::unexpected(overlay.error());
+    v->overlay_ = std::move(*overlay);
+  }
+  return v;
+}
+
+Result<void> VideoStreams::beforeDraw(const FrameContext& frame) {
+  for (const auto& s : streams_) {
+    media::MoviePlayer& player = *s->player;
+    if (manualClock_) player.waitForFrameDue(frame.time, std::chrono::seconds(10));
+    const FrameRef f = player.frameAt(frame.time);
+    const media::MovieState state = player.state();
+    if (state != s->lastState) {
+      s->lastState = state;
+      if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) s->texture->showFallback();
+    }
+    if (state == media::MovieState::kFailed) continue;
+    auto changed = s->texture->update(f);
+    if (!changed) {
+      log::error(kLogKiosk, "{}; showing the fallback texture", changed.error().describe());
+      s->texture->showFallback();
+      player.unload();
+      s->lastState = media::MovieState::kEmpty;
+    }
+    s->texture->publish(renderer_.textures());
+  }
+  return {};
+}
+
+Result<void> VideoStreams::afterDraw(const FrameContext&, render::Output& output) {
+  if (!overlay_) return {};
+  for (const auto& s : streams_) {
+    if (!s->spec.zoom) continue;
+    const render::TextureView& view = s->texture->view();
+    if (!s->zoomPlaced) {
+      s->zoomRect = {s->spec.zoom->x, s->spec.zoom->y, 0, 0};
+      s->zoomPlaced = true;
+    }
+    const double aspect = s->player->info().pixelAspect;
+    s->zoomRect.width = static_cast<float>(view.size.width * s->spec.zoom->scale * (aspect > 0 ? aspect : 1.0));
+    s->zoomRect.height = static_cast<float>(view.size.height * s->spec.zoom->scale);
+    overlay_->draw(view, s->zoomRect, output.size());
+  }
+  return {};
+}
+
+media::MoviePlayer* VideoStreams::player(std::string_view name) {
+  for (const auto& s : streams_) {
+    if (s->spec.name == name) return s->player.get();
+  }
+  return nullptr;
+}
+
+void VideoStreams::moveZoom(std::string_view name, float dx, float dy) {
+  for (const auto& s : streams_) {
+    if (s->spec.name != name || !s->spec.zoom) continue;
+    if (!s->zoomPlaced) {
+      s->zoomRect = {s->spec.zoom->x, s->spec.zoom->y, 0, 0};
+      s->zoomPlaced = true;
+    }
+    s->zoomRect.x += dx;
+    s->zoomRect.y += dy;
+  }
+}
+
+std::vector<std::string> VideoStreams::status() const {
+  std::vector<std::string> lines;
+  for (const auto& s : streams_) {
+    const media::MovieInfo info = s->player->info();
+    const char* state = "empty";
+    switch (s->player->state()) {
+      case media::MovieState::kLoading: state = "loading"; break;
+      case media::MovieState::kReady: state = "playing"; break;
+      case media::MovieState::kFailed: state = "failed"; break;
+      case media::MovieState::kEmpty: break;
+    }
+    const media::MoviePlayerStats st = s->player->stats();
+    lines.push_back(fmt::format("movie '{}': {} ({}), frame {} of {}, {} shown, {} loops; {}", s->spec.name,
+                                info.path.filename(), state, s->player->currentFrame(), info.frameCount, st.shown,
+                                st.loops, s->texture->describe()));
+  }
+  return lines;
+}
+
+Result<std::unique_ptr<ScreenRecorder>> ScreenRecorder::create(const media::RecorderOptions& options) {
+  auto recorder = media::Recorder::create(options);
+  if (!recorder) return std::unexpected(recorder.error());
+  return std::unique_ptr<ScreenRecorder>(new ScreenRecorder(std::move(*recorder), options));
+}
+
+Result<void> ScreenRecorder::afterDraw(const FrameContext&, render::Output& output) {
+  if (!recorder_ || failure_ || recorder_->full()) return {};
+  if (auto r = output.readBack(frame_); !r) return r;
+  if (auto r = recorder_->push(frame_); !r) {
+    // A full disk ends the recording, not the show.
+    failure_ = r.error();
+    log::error(kLogKiosk, "{}; the show goes on without recording", r.error().describe());
+  }
+  return {};
+}
+
+Result<void> ScreenRecorder::finish() {
+  if (!recorder_) return {};
+  auto r = recorder_->finish();
+  if (failure_) return std::unexpected(*failure_);
+  return r;
+}
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,60 @@
+#version 300 es
+// YUV (or RGB) planes as the decoder or camera made them -> RGBA, once per new video frame.
+// The matrix and offsets carry the stream's colorimetry (BT.601/709/2020, limited/full range).
+// StreamTexture compiles one variant per layout (LAYOUT is defined in front of this text), so
+// that no pixel pays for a branch: software renderers run every branch of a shader.
+precision highp float;
+precision highp int;
+
+#define LAYOUT_RGBA 0
+#define LAYOUT_BGRA 1
+#define LAYOUT_GRAY 2
+#define LAYOUT_THREE_PLANES 3  // I420 (U then V) and YV12 (bound swapped)
+#define LAYOUT_NV12 4
+#define LAYOUT_NV21 5
+#define LAYOUT_YUYV 6  // Y0 U Y1 V: one RGBA texel holds two pixels
+#define LAYOUT_UYVY 7  // U Y0 V Y1
+
+uniform sampler2D uPlane0;  // Y (R8), packed 4:2:2 (RGBA8) or RGB(A)
+uniform sampler2D uPlane1;  // U (R8) or interleaved UV (RG8)
+uniform sampler2D uPlane2;  // V (R8)
+// rgb = y * uYCoef + u * uUCoef + v * uVCoef + uBias: the matrix columns with the range and the
+// offsets folded in (three multiply-adds; the RGBA8 target clamps).
+uniform vec3 uYCoef;
+uniform vec3 uUCoef;
+uniform vec3 uVCoef;
+uniform vec3 uBias;
+
+in vec2 vUv;
+out vec4 fragColor;
+
+vec3 toRgb(vec3 yuv) { return yuv.x * uYCoef + yuv.y * uUCoef + yuv.z * uVCoef + uBias; }
+
+void main() {
+  // The target has the frame's size: every sample is a texel fetch (no filtering), chroma at
+  // half resolution: 4:2:0 chroma sited with its top-left luma sample.
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  ivec2 cx = px >> 1;  // a shift: software renderers cannot vectorise integer division
+#if LAYOUT == LAYOUT_RGBA
+  fragColor = vec4(texelFetch(uPlane0, px, 0).rgb, 1.0);
+#elif LAYOUT == LAYOUT_BGRA
+  fragColor = vec4(texelFetch(uPlane0, px, 0).bgr, 1.0);
+#elif LAYOUT == LAYOUT_GRAY
+  fragColor = vec4(vec3(texelFetch(uPlane0, px, 0).r), 1.0);
+#elif LAYOUT == LAYOUT_THREE_PLANES
+  fragColor = vec4(toRgb(vec3(texelFetch(uPlane0, px, 0).r, texelFetch(uPlane1, cx, 0).r, texelFetch(uPlane2, cx, 0).r)), 1.0);
+#elif LAYOUT == LAYOUT_NV12
+  fragColor = vec4(toRgb(vec3(texelFetch(uPlane0, px, 0).r, texelFetch(uPlane1, cx, 0).rg)), 1.0);
+#elif LAYOUT == LAYOUT_NV21
+  fragColor = vec4(toRgb(vec3(texelFetch(uPlane0, px, 0).r, texelFetch(uPlane1, cx, 0).gr)), 1.0);
+#else
+  vec4 t = texelFetch(uPlane0, ivec2(px.x >> 1, px.y), 0);
+  bool odd = (px.x & 1) == 1;
+#if LAYOUT == LAYOUT_YUYV
+  vec3 yuv = vec3(odd ? t.b : t.r, t.g, t.a);
+#else
+  vec3 yuv = vec3(odd ? t.a : t.g, t.r, t.b);
+#endif
+  fragColor = vec4(toRgb(yuv), 1.0);
+#endif
+}

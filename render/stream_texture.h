@@ -1,0 +1,119 @@
+#pragma once
+
+/// \file
+/// \brief Video as textures: a stream's frames (movie, camera, capture card) uploaded plane by
+/// plane as they come and converted to RGBA in a shader, once per new frame however many parts
+/// show it; and the Zoom picture (LAVA §7.1, §4.3), a stream drawn flat over the scene.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "render/gl.h"
+#include "render/output.h"
+#include "render/texture_registry.h"
+#include "runtime/error.h"
+#include "runtime/frame.h"
+#include "runtime/image.h"
+
+namespace basalt::render {
+
+/// \brief How a frame reached the GPU.
+enum class UploadPath : std::uint8_t {
+  kNone,          ///< nothing uploaded yet (the fallback shows)
+  kPlanes,        ///< CPU planes uploaded as textures, converted in the shader
+  kDmabufImport,  ///< dmabuf planes imported as EGL images (no copy), converted in the shader
+};
+
+std::string_view uploadPathName(UploadPath path);
+
+/// \brief One stream's RGBA texture, registered in a TextureRegistry under the stream's name.
+///
+/// Threading: the frame loop's thread with the GL context current. update() never blocks and,
+/// once the planes and target exist for a size, allocates nothing.
+class StreamTexture {
+ public:
+  /// \brief Compiles the conversion shader; needs a current OpenGL ES 3 context. `name` is the
+  /// texture name parts use (`PartState::texture`).
+  [[nodiscard]] static Result<std::unique_ptr<StreamTexture>> create(std::string name);
+  ~StreamTexture();
+  StreamTexture(const StreamTexture&) = delete;
+  StreamTexture& operator=(const StreamTexture&) = delete;
+
+  /// \brief Shows `frame` if it is new (an empty ref or the frame already shown changes
+  /// nothing). Returns true when the texture changed. Leaves the GL framebuffer, viewport and
+  /// program bindings as it found them... except the framebuffer: callers bind theirs after.
+  [[nodiscard]] Result<bool> update(const FrameRef& frame);
+  /// \brief Fills the texture with the fallback colour (the source failed or is absent).
+  void showFallback();
+  /// \brief The fallback colour (RGBA 0..1); default dark grey.
+  void setFallbackColor(float r, float g, float b);
+  [[nodiscard]] bool showingFallback() const { return fallback_; }
+
+  /// \brief Registers (or refreshes) the texture under name() in `registry`.
+  void publish(TextureRegistry& registry) const;
+  [[nodiscard]] const std::string& name() const { return name_; }
+  [[nodiscard]] const TextureView& view() const { return view_; }
+  [[nodiscard]] UploadPath uploadPath() const { return path_; }
+  /// \brief One line for logs and the status server: path, format, size and colorimetry.
+  [[nodiscard]] std::string describe() const;
+  /// \brief YUV-to-RGB conversions run (one per new frame).
+  [[nodiscard]] std::uint64_t conversions() const { return conversions_; }
+  /// \brief Whether this EGL display can import dmabufs (EGL_EXT_image_dma_buf_import).
+  [[nodiscard]] bool dmabufImportOffered() const { return dmabufOffered_; }
+
+  /// \brief Reads the RGBA texture back, top row first (tests and snapshots).
+  [[nodiscard]] Result<void> readPixels(Image& out) const;
+
+ private:
+  struct Gpu;
+  explicit StreamTexture(std::string name);
+  Result<void> ensureTarget(std::uint32_t width, std::uint32_t height);
+  Result<void> uploadPlanes(const Frame& frame);
+  Result<void> importDmabuf(const Frame& frame);
+  Result<void> uploadRgba(const Frame& frame);
+  Result<void> convert(const Frame& frame);
+
+  std::string name_;
+  std::unique_ptr<Gpu> gpu_;
+  TextureView view_;
+  UploadPath path_ = UploadPath::kNone;
+  PixelFormat format_ = PixelFormat::kUnknown;
+  Colorimetry colorimetry_{};
+  const Frame* shown_ = nullptr;  // identity of the frame on the texture (never dereferenced)
+  std::uint64_t shownSequence_ = 0;
+  std::int64_t shownPts_ = -1;
+  std::uint64_t conversions_ = 0;
+  bool fallback_ = true;
+  bool dmabufOffered_ = false;
+  float fallbackColor_[3] = {0.12f, 0.12f, 0.12f};
+};
+
+/// \brief Where the Zoom picture sits, in output pixels from the top-left corner.
+struct PictureRect {
+  float x = 0;
+  float y = 0;
+  float width = 0;
+  float height = 0;
+};
+
+/// \brief Draws textures flat over the scene: LAVA's Zoom picture of a movie ("1/2x", "1x",
+/// "2x", or any size), movable (Shift + drag in LAVA §4.3; `move()` here).
+class PictureOverlay {
+ public:
+  [[nodiscard]] static Result<std::unique_ptr<PictureOverlay>> create();
+  ~PictureOverlay();
+  PictureOverlay(const PictureOverlay&) = delete;
+  PictureOverlay& operator=(const PictureOverlay&) = delete;
+
+  /// \brief Draws `texture` into the bound framebuffer of `viewport` size at `rect`.
+  void draw(const TextureView& texture, const PictureRect& rect, Size viewport, float opacity = 1.0f);
+
+ private:
+  struct Gpu;
+  PictureOverlay();
+  std::unique_ptr<Gpu> gpu_;
+};
+
+}  // namespace basalt::render

@@ -1,0 +1,512 @@
+// Trace folders: trace.toml (a small TOML subset that Basalt writes and reads: `key = value`
+// with strings, numbers and booleans, `[[device]]` tables, comments), hid-recorder files for
+// dial boxes and trace videos for cameras. File names in trace.toml may not leave the folder.
+
+#include "sim/trace.h"
+
+#include <charconv>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/chrono.h>
+#include <fmt/format.h>
+
+#include "sim/hid_recording.h"
+#include "sim/raw_video.h"
+
+namespace basalt::sim {
+
+namespace {
+
+std::string quote(std::string_view s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string hexBytes(const std::vector<std::uint8_t>& bytes) {
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (i) out += " ";
+    out += fmt::format("{:02x}", bytes[i]);
+  }
+  return out;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+struct Value {
+  enum class Type : std::uint8_t { kString, kNumber, kBool } type = Type::kString;
+  std::string text;
+  double number = 0;
+  bool boolean = false;
+};
+
+/// Parses the value after '=' (and an optional trailing comment); false with `why` on error.
+bool parseValue(std::string_view s, Value& v, std::string& why) {
+  s = trim(s);
+  if (s.empty()) {
+    why = "a value is missing after '='";
+    return false;
+  }
+  std::string_view rest;
+  if (s.front() == '"') {
+    v.type = Value::Type::kString;
+    std::size_t i = 1;
+    for (; i < s.size() && s[i] != '"'; ++i) {
+      if (s[i] == '\\' && i + 1 < s.size()) {
+        const char e = s[++i];
+        switch (e) {
+          case 'n': v.text += '\n'; break;
+          case 't': v.text += '\t'; break;
+          case '"': v.text += '"'; break;
+          case '\\': v.text += '\\'; break;
+          case 'u': {
+            unsigned code = 0;
+            if (i + 4 >= s.size() || std::from_chars(s.data() + i + 1, s.data() + i + 5, code, 16).ec != std::errc{}) {
+              why = "a \\u escape needs four hexadecimal digits";
+              return false;
+            }
+            v.text += static_cast<char>(code < 0x80 ? code : '?');
+            i += 4;
+            break;
+          }
+          default: why = fmt::format("unknown escape '\\{}'", e); return false;
+        }
+      } else {
+        v.text += s[i];
+      }
+    }
+    if (i >= s.size()) {
+      why = "a string is not closed with '\"'";
+      return false;
+    }
+    rest = trim(s.substr(i + 1));
+  } else {
+    const auto hash = s.find('#');
+    const std::string_view word = trim(s.substr(0, hash));
+    rest = hash == std::string_view::npos ? std::string_view{} : s.substr(hash);
+    if (word == "true" || word == "false") {
+      v.type = Value::Type::kBool;
+      v.boolean = word == "true";
+    } else {
+      v.type = Value::Type::kNumber;
+      const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), v.number);
+      if (ec != std::errc{} || end != word.data() + word.size() || !std::isfinite(v.number)) {
+        why = fmt::format("'{}' is not a string, number or true/false", word);
+        return false;
+      }
+    }
+  }
+  if (!rest.empty() && rest.front() != '#') {
+    why = fmt::format("unexpected '{}' after the value", rest.substr(0, 20));
+    return false;
+  }
+  return true;
+}
+
+bool parseHexList(std::string_view s, std::vector<std::uint8_t>& out) {
+  out.clear();
+  std::size_t i = 0;
+  while (i < s.size()) {
+    while (i < s.size() && s[i] == ' ') ++i;
+    if (i >= s.size()) break;
+    unsigned v = 0;
+    const auto [end, ec] = std::from_chars(s.data() + i, s.data() + std::min(s.size(), i + 2), v, 16);
+    if (ec != std::errc{} || end != s.data() + std::min(s.size(), i + 2)) return false;
+    if (out.size() >= 65536) return false;
+    out.push_back(static_cast<std::uint8_t>(v));
+    i += 2;
+  }
+  return true;
+}
+
+PixelFormat formatByName(std::string_view name) {
+  for (int f = 1; f <= static_cast<int>(PixelFormat::kMjpeg); ++f) {
+    if (pixelFormatName(static_cast<PixelFormat>(f)) == name) return static_cast<PixelFormat>(f);
+  }
+  return PixelFormat::kUnknown;
+}
+
+}  // namespace
+
+std::string formatTraceToml(const TraceInfo& info) {
+  std::string out = "# A Basalt trace: replay it with the replay backend (see ARCHITECTURE.md, \"Traces\").\n";
+  out += "format = 1\n";
+  out += fmt::format("recorded = {}\n", quote(info.recorded));
+  out += fmt::format("host = {}\n", quote(info.host));
+  out += fmt::format("basalt = {}\n", quote(info.basalt));
+  out += fmt::format("fps = {}\n", info.fps);
+  out += fmt::format("seconds = {:.6f}\n", info.seconds);
+  for (const TraceDevice& d : info.devices) {
+    out += "\n[[device]]\n";
+    out += fmt::format("name = {}\n", quote(d.name));
+    out += fmt::format("kind = {}\n", quote(d.kind == devices::DeviceKind::kDialBox ? "dial box" : "video source"));
+    out += fmt::format("file = {}\n", quote(d.file));
+    out += fmt::format("device = {}\n", quote(d.info.name));
+    out += fmt::format("backend = {}\n", quote(d.info.backend));
+    out += fmt::format("bus = {}\n", quote(d.info.bus));
+    out += fmt::format("vendor = \"{:04x}\"\n", d.info.vendor);
+    out += fmt::format("product = \"{:04x}\"\n", d.info.product);
+    out += fmt::format("path = {}\n", quote(d.info.path));
+    if (!d.info.serial.empty()) out += fmt::format("serial = {}\n", quote(d.info.serial));
+    if (d.kind == devices::DeviceKind::kDialBox) {
+      out += fmt::format("descriptor = \"{}\"\n", hexBytes(d.descriptor));
+    } else {
+      out += fmt::format("format = {}\n", quote(pixelFormatName(d.mode.format)));
+      out += fmt::format("width = {}\nheight = {}\n", d.mode.width, d.mode.height);
+      out += fmt::format("video_fps = {}\n", d.mode.fps);
+    }
+  }
+  return out;
+}
+
+Result<TraceInfo> parseTraceToml(std::string_view text, std::string_view name) {
+  TraceInfo info;
+  TraceDevice* device = nullptr;
+  int lineNo = 0;
+  bool sawFormat = false;
+  auto bad = [&](std::string what) { return fail(Errc::kParse, std::move(what), fmt::format("{}:{}", name, lineNo)); };
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t nl = text.find('\n', pos);
+    const std::string_view line = trim(text.substr(pos, nl == std::string_view::npos ? text.size() - pos : nl - pos));
+    pos = nl == std::string_view::npos ? text.size() + 1 : nl + 1;
+    ++lineNo;
+    if (line.empty() || line.front() == '#') continue;
+    if (line == "[[device]]") {
+      if (info.devices.size() >= 64) return bad("more than 64 devices");
+      info.devices.emplace_back();
+      device = &info.devices.back();
+      continue;
+    }
+    if (line.front() == '[') return bad(fmt::format("unknown table '{}'; a trace has only [[device]] tables", line));
+    const auto eq = line.find('=');
+    if (eq == std::string_view::npos) return bad("expected 'key = value'");
+    const std::string_view key = trim(line.substr(0, eq));
+    Value v;
+    std::string why;
+    if (!parseValue(line.substr(eq + 1), v, why)) return bad(why);
+    auto str = [&]() -> Result<std::string> {
+      if (v.type != Value::Type::kString) return bad(fmt::format("{} must be a string", key));
+      return v.text;
+    };
+    auto num = [&](double lo, double hi) -> Result<double> {
+      if (v.type != Value::Type::kNumber || v.number < lo || v.number > hi) {
+        return bad(fmt::format("{} must be a number from {} to {}", key, lo, hi));
+      }
+      return v.number;
+    };
+    auto hex16 = [&](std::uint16_t& out) -> Result<void> {
+      auto s = str();
+      if (!s) return std::unexpected(s.error());
+      unsigned x = 0;
+      const auto [end, ec] = std::from_chars(s->data(), s->data() + s->size(), x, 16);
+      if (ec != std::errc{} || end != s->data() + s->size() || x > 0xffff) {
+        return bad(fmt::format("{} must be 4 hexadecimal digits", key));
+      }
+      out = static_cast<std::uint16_t>(x);
+      return {};
+    };
+    Result<void> r;
+    if (!device) {
+      if (key == "format") {
+        auto n = num(1, 1);
+        if (!n) return bad("this trace was written by a newer Basalt (format is not 1)");
+        sawFormat = true;
+      } else if (key == "recorded") {
+        auto s = str();
+        if (!s) return std::unexpected(s.error());
+        info.recorded = *s;
+      } else if (key == "host") {
+        auto s = str();
+        if (!s) return std::unexpected(s.error());
+        info.host = *s;
+      } else if (key == "basalt") {
+        auto s = str();
+        if (!s) return std::unexpected(s.error());
+        info.basalt = *s;
+      } else if (key == "fps") {
+        auto n = num(0, 1000);
+        if (!n) return std::unexpected(n.error());
+        info.fps = *n;
+      } else if (key == "seconds") {
+        auto n = num(0, 1e9);
+        if (!n) return std::unexpected(n.error());
+        info.seconds = *n;
+      }
+      continue;
+    }
+    TraceDevice& d = *device;
+    if (key == "name" || key == "file" || key == "device" || key == "backend" || key == "bus" || key == "path" ||
+        key == "serial" || key == "kind" || key == "format" || key == "descriptor") {
+      auto s = str();
+      if (!s) return std::unexpected(s.error());
+      if (key == "name") d.name = *s;
+      if (key == "device") d.info.name = *s;
+      if (key == "backend") d.info.backend = *s;
+      if (key == "bus") d.info.bus = *s;
+      if (key == "path") d.info.path = *s;
+      if (key == "serial") d.info.serial = *s;
+      if (key == "file") {
+        if (s->empty() || s->find('/') != std::string::npos || s->find('\\') != std::string::npos || *s == "." ||
+            *s == "..") {
+          return bad(fmt::format("file '{}' must be a file name inside the trace folder", *s));
+        }
+        d.file = *s;
+      }
+      if (key == "kind") {
+        if (*s == "dial box") {
+          d.kind = devices::DeviceKind::kDialBox;
+        } else if (*s == "video source") {
+          d.kind = devices::DeviceKind::kVideoSource;
+        } else {
+          return bad(fmt::format("kind '{}' is not \"dial box\" or \"video source\"", *s));
+        }
+      }
+      if (key == "format") {
+        d.mode.format = formatByName(*s);
+        if (d.mode.format == PixelFormat::kUnknown) return bad(fmt::format("unknown pixel format '{}'", *s));
+      }
+      if (key == "descriptor" && !parseHexList(*s, d.descriptor)) return bad("descriptor must be hexadecimal bytes");
+    } else if (key == "vendor") {
+      r = hex16(d.info.vendor);
+    } else if (key == "product") {
+      r = hex16(d.info.product);
+    } else if (key == "width" || key == "height") {
+      auto n = num(1, 16384);
+      if (!n) return std::unexpected(n.error());
+      (key == "width" ? d.mode.width : d.mode.height) = static_cast<std::uint32_t>(*n);
+    } else if (key == "video_fps") {
+      auto n = num(0, 1000);
+      if (!n) return std::unexpected(n.error());
+      d.mode.fps = *n;
+    }
+    if (!r) return std::unexpected(r.error());
+  }
+  lineNo = 0;
+  if (!sawFormat) return fail(Errc::kParse, "'format = 1' is missing; is this a Basalt trace.toml?", std::string(name));
+  for (const TraceDevice& d : info.devices) {
+    if (d.name.empty() || d.file.empty()) {
+      return fail(Errc::kParse, "every [[device]] needs a name and a file", std::string(name));
+    }
+  }
+  return info;
+}
+
+Result<TraceInfo> readTrace(const std::filesystem::path& folder) {
+  const std::filesystem::path file = folder / "trace.toml";
+  std::ifstream in(file);
+  if (!in) {
+    return fail(Errc::kNotFound, "cannot read trace.toml; is this a trace folder made by 'basalt record'?",
+                folder.string());
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  auto info = parseTraceToml(text.str(), file.string());
+  if (info) info->folder = folder;
+  return info;
+}
+
+// TraceRecorder
+
+Result<std::unique_ptr<TraceRecorder>> TraceRecorder::create(const std::filesystem::path& folder, const Clock& clock,
+                                                             Options options) {
+  std::error_code ec;
+  if (std::filesystem::exists(folder, ec) && !std::filesystem::is_empty(folder, ec)) {
+    return fail(Errc::kInvalidArgument, "the trace folder exists and is not empty; choose a new name", folder.string());
+  }
+  std::filesystem::create_directories(folder, ec);
+  if (ec) return fail(Errc::kIo, "cannot create the trace folder: " + ec.message(), folder.string());
+  if (!options.videoWriter) options.videoWriter = rawVideoWriterFactory();
+  return std::unique_ptr<TraceRecorder>(new TraceRecorder(folder, clock, std::move(options)));
+}
+
+TraceRecorder::TraceRecorder(std::filesystem::path folder, const Clock& clock, Options options)
+    : folder_(std::move(folder)), clock_(clock), options_(std::move(options)), start_(clock.now()) {
+  info_.folder = folder_;
+  info_.host = options_.host;
+  info_.basalt = options_.basaltVersion;
+  info_.fps = options_.fps;
+  info_.recorded = fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", std::chrono::floor<std::chrono::seconds>(clock.wallNow()));
+  writer_ = std::thread([this] { writerLoop(); });
+}
+
+TraceRecorder::~TraceRecorder() {
+  if (auto r = finish(); !r) return;  // a destructor cannot report: call finish() to see the error
+}
+
+void TraceRecorder::noteError(const Error& e) {
+  if (!firstError_) firstError_ = e;
+}
+
+Result<void> TraceRecorder::addDialBox(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
+                                       const std::vector<std::uint8_t>& descriptor) {
+  std::lock_guard lock(mutex_);
+  if (dials_.contains(id)) return {};
+  TraceDevice d;
+  d.name = name;
+  d.kind = devices::DeviceKind::kDialBox;
+  d.info = info;
+  d.file = name + ".hid";
+  d.descriptor = descriptor;
+  DialFile f;
+  f.out.open(folder_ / d.file, std::ios::binary | std::ios::trunc);
+  if (!f.out) return fail(Errc::kIo, "cannot create the recording file", (folder_ / d.file).string());
+  HidRecordedDevice header;
+  header.name = info.name;
+  header.bus = info.bus == "usb" ? 3 : (info.bus == "bluetooth" ? 5 : 6);
+  header.vendor = info.vendor;
+  header.product = info.product;
+  header.descriptor = descriptor;
+  f.out << "# Recorded by " << options_.basaltVersion << " (basalt record) from " << devices::describeDevice(info)
+        << "\n";
+  f.out << HidRecordingWriter::header(header, false);
+  f.index = info_.devices.size();
+  info_.devices.push_back(std::move(d));
+  dials_.emplace(id, std::move(f));
+  return {};
+}
+
+Result<void> TraceRecorder::addVideoSource(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
+                                           const devices::VideoMode& mode) {
+  std::lock_guard lock(mutex_);
+  if (videos_.contains(id)) return {};
+  TraceDevice d;
+  d.name = name;
+  d.kind = devices::DeviceKind::kVideoSource;
+  d.info = info;
+  d.mode = mode;
+  VideoFile f;
+  auto writer = options_.videoWriter(folder_, name, mode, d.file);
+  if (!writer) return std::unexpected(writer.error());
+  f.writer = std::move(*writer);
+  f.index = info_.devices.size();
+  info_.devices.push_back(std::move(d));
+  videos_.emplace(id, std::move(f));
+  return {};
+}
+
+void TraceRecorder::onReport(DeviceId device, Nanos time, std::span<const std::uint8_t> report) {
+  std::lock_guard lock(mutex_);
+  if (stopping_) return;
+  auto it = dials_.find(device);
+  if (it == dials_.end()) return;
+  it->second.out << HidRecordingWriter::reportLine(time - start_, report);
+  if (!it->second.out)
+    noteError(Error(Errc::kIo, "cannot write the recording (disk full?)", info_.devices[it->second.index].file));
+  ++reports_;
+  lastTime_ = std::max(lastTime_, time - start_);
+}
+
+void TraceRecorder::onFrame(DeviceId device, const FrameRef& frame) {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_ || !videos_.contains(device)) return;
+    if (frames_.size() >= 8) {
+      ++framesDropped_;
+      return;
+    }
+    frames_.push_back({device, frame});
+  }
+  framesReady_.notify_one();
+}
+
+void TraceRecorder::writerLoop() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    framesReady_.wait(lock, [this] { return stopping_ || !frames_.empty(); });
+    if (frames_.empty()) {
+      framesDone_.notify_all();
+      if (stopping_) return;
+      continue;
+    }
+    PendingFrame p = std::move(frames_.front());
+    frames_.pop_front();
+    auto it = videos_.find(p.device);
+    if (it == videos_.end()) continue;
+    TraceVideoWriter* writer = it->second.writer.get();
+    const Nanos pts = p.frame->pts - start_;
+    lastTime_ = std::max(lastTime_, pts);
+    writing_ = true;
+    lock.unlock();  // write without holding the lock: device threads keep queueing
+    auto r = writer->write(*p.frame, pts);
+    p.frame.reset();
+    lock.lock();
+    writing_ = false;
+    if (frames_.empty()) framesDone_.notify_all();
+    if (r) {
+      ++framesWritten_;
+    } else {
+      noteError(r.error());
+    }
+  }
+}
+
+bool TraceRecorder::drain(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  return framesDone_.wait_for(lock, timeout, [this] { return frames_.empty() && !writing_; });
+}
+
+Result<TraceInfo> TraceRecorder::finish() {
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_ && !writer_.joinable()) {
+      if (firstError_) return std::unexpected(*firstError_);
+      return info_;
+    }
+    stopping_ = true;
+  }
+  framesReady_.notify_all();
+  if (writer_.joinable()) writer_.join();
+  std::lock_guard lock(mutex_);
+  for (auto& [id, f] : dials_) {
+    f.out.flush();
+    if (!f.out) noteError(Error(Errc::kIo, "cannot write the recording (disk full?)", info_.devices[f.index].file));
+    f.out.close();
+  }
+  for (auto& [id, f] : videos_) {
+    if (auto r = f.writer->finish(); !r) noteError(r.error());
+  }
+  info_.seconds = toSeconds(std::max(lastTime_, clock_.now() - start_));
+  std::ofstream toml(folder_ / "trace.toml", std::ios::trunc);
+  toml << formatTraceToml(info_);
+  toml.close();
+  if (!toml) noteError(Error(Errc::kIo, "cannot write trace.toml", folder_.string()));
+  if (firstError_) return std::unexpected(*firstError_);
+  return info_;
+}
+
+std::uint64_t TraceRecorder::reportsWritten() const {
+  std::lock_guard lock(mutex_);
+  return reports_;
+}
+std::uint64_t TraceRecorder::framesWritten() const {
+  std::lock_guard lock(mutex_);
+  return framesWritten_;
+}
+std::uint64_t TraceRecorder::framesDropped() const {
+  std::lock_guard lock(mutex_);
+  return framesDropped_;
+}
+
+}  // namespace basalt::sim

@@ -1,0 +1,138 @@
+#pragma once
+
+/// \file
+/// \brief Traces (DESIGN.md §5): a folder `NAME.trace/` with `trace.toml` (when, where, each
+/// device's identity and file, the frame rate), one hid-recorder file per dial box and one video
+/// file per video source. TraceRecorder writes one from live devices; readTrace() reads it back
+/// for the replay backend.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "devices/device.h"
+#include "devices/video_source.h"
+#include "runtime/clock.h"
+#include "runtime/error.h"
+#include "sim/trace_video.h"
+
+namespace basalt::sim {
+
+/// \brief One recorded device, as trace.toml lists it.
+struct TraceDevice {
+  std::string name;  ///< the show's name for it ("dials")
+  devices::DeviceKind kind = devices::DeviceKind::kDialBox;
+  devices::DeviceInfo info;              ///< identity at recording time
+  std::string file;                      ///< relative to the trace folder
+  std::vector<std::uint8_t> descriptor;  ///< dial boxes: the report descriptor
+  devices::VideoMode mode;               ///< video sources
+};
+
+struct TraceInfo {
+  std::filesystem::path folder;
+  std::string recorded;  ///< ISO 8601 UTC
+  std::string host;
+  std::string basalt;  ///< version that wrote it
+  double fps = 0;      ///< the show's frame rate while recording
+  double seconds = 0;  ///< length
+  std::vector<TraceDevice> devices;
+};
+
+/// \brief Reads `folder/trace.toml`. Errors name the file and line.
+[[nodiscard]] Result<TraceInfo> readTrace(const std::filesystem::path& folder);
+/// \brief Parses the text of a trace.toml (for tests and the fuzzer).
+[[nodiscard]] Result<TraceInfo> parseTraceToml(std::string_view text, std::string_view name = "trace.toml");
+/// \brief The text of trace.toml for `info`.
+std::string formatTraceToml(const TraceInfo& info);
+
+/// \brief Taps live devices into a trace folder.
+///
+/// Threading: addDialBox()/addVideoSource()/finish() from the owner's thread; onReport() and
+/// onFrame() from device threads (reports are written under `mutex_`; frames are queued for the
+/// writer thread, at most 8, so that a slow disk drops recorded frames instead of stalling the
+/// camera).
+class TraceRecorder final : public devices::ReportTap, public devices::FrameTap {
+ public:
+  struct Options {
+    std::string host;
+    std::string basaltVersion;
+    double fps = 60;
+    TraceVideoWriterFactory videoWriter;  ///< default: raw .bvraw files
+  };
+
+  /// \brief Creates `folder` (which must not exist or be empty) and starts the recording clock.
+  [[nodiscard]] static Result<std::unique_ptr<TraceRecorder>> create(const std::filesystem::path& folder,
+                                                                     const Clock& clock, Options options);
+  ~TraceRecorder() override;
+
+  /// \brief Records device `id` (the DeviceManager's id) as `name`.
+  [[nodiscard]] Result<void> addDialBox(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
+                                        const std::vector<std::uint8_t>& descriptor);
+  [[nodiscard]] Result<void> addVideoSource(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
+                                            const devices::VideoMode& mode);
+
+  void onReport(DeviceId device, Nanos time, std::span<const std::uint8_t> report) override;
+  void onFrame(DeviceId device, const FrameRef& frame) override;
+
+  /// \brief Waits until every frame queued so far is written (at most `timeout`). A recording
+  /// under a ManualClock runs faster than real time; calling this once per frame keeps the
+  /// camera's frame pool from running dry while the writer catches up.
+  bool drain(std::chrono::milliseconds timeout = std::chrono::seconds(5));
+
+  /// \brief Stops, flushes every file and writes trace.toml. The first write error, if any.
+  [[nodiscard]] Result<TraceInfo> finish();
+
+  [[nodiscard]] std::uint64_t reportsWritten() const;
+  [[nodiscard]] std::uint64_t framesWritten() const;
+  [[nodiscard]] std::uint64_t framesDropped() const;
+
+ private:
+  TraceRecorder(std::filesystem::path folder, const Clock& clock, Options options);
+  void writerLoop();
+  void noteError(const Error& e);
+
+  struct DialFile {
+    std::ofstream out;
+    std::size_t index = 0;  // in info_.devices
+  };
+  struct VideoFile {
+    std::unique_ptr<TraceVideoWriter> writer;
+    std::size_t index = 0;
+  };
+  struct PendingFrame {
+    DeviceId device = 0;
+    FrameRef frame;
+  };
+
+  std::filesystem::path folder_;
+  const Clock& clock_;
+  Options options_;
+  Nanos start_{0};
+  mutable std::mutex mutex_;  // guards everything below
+  TraceInfo info_;
+  std::map<DeviceId, DialFile> dials_;
+  std::map<DeviceId, VideoFile> videos_;
+  std::deque<PendingFrame> frames_;
+  std::condition_variable framesReady_;
+  std::condition_variable framesDone_;
+  bool writing_ = false;  // the writer thread holds a frame outside the lock
+  bool stopping_ = false;
+  std::optional<Error> firstError_;
+  std::uint64_t reports_ = 0;
+  std::uint64_t framesWritten_ = 0;
+  std::uint64_t framesDropped_ = 0;
+  Nanos lastTime_{0};
+  std::thread writer_;
+};
+
+}  // namespace basalt::sim

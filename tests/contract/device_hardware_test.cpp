@@ -1,0 +1,171 @@
+// Real hardware paths the contract suites do not cover, run in the virtual lab (skipping with the
+// reason elsewhere): an HDMI input that loses its signal, gets it back and changes resolution
+// renegotiates by itself (vivid's "DV Timings Signal Mode" control); USB gadgets unplugged and
+// replugged from their UDC drive the DeviceManager through lost and back to live through udev;
+// V4L2 enumeration describes vivid's nodes.
+// Example failures: a capture thread stuck in DQBUF after the signal went; a stream that stays
+// lost after the cable is back; a dial box that needs a restart after a replug.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <thread>
+
+#include "devices/device_manager.h"
+#include "devices/hid/hid_backend.h"
+#include "devices/udev/udev_monitor.h"
+#include "devices/v4l2/v4l2_camera.h"
+#include "vlab.h"
+
+namespace basalt::devices {
+namespace {
+
+using namespace std::chrono_literals;
+
+/// Runs `step` every 10 ms until `done` or `limit` of real time.
+template <typename Step, typename Done>
+bool waitFor(Step step, Done done, std::chrono::milliseconds limit) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  while (std::chrono::steady_clock::now() < end) {
+    step();
+    if (done()) return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return false;
+}
+
+TEST(V4l2Hardware, HdmiSignalLossAndResolutionChangeRenegotiate) {
+  const auto node = test::vlabEnv("BASALT_VLAB_V4L2_HDMI");
+  if (!node) GTEST_SKIP() << test::needsVlab("BASALT_VLAB_V4L2_HDMI (vivid HDMI input)");
+  SystemClock clock;
+  auto source = makeV4l2Camera(*node, {}, clock);
+  ASSERT_TRUE(source->open(1));
+  auto serviceAndDrain = [&] {
+    source->service(clock.now());
+    (void)source->frameAt(clock.now());
+  };
+  ASSERT_TRUE(waitFor(serviceAndDrain, [&] { return source->framesDelivered() > 2; }, 5s)) << "no frames";
+  const VideoMode before = source->mode();
+  // vivid: "DV Timings Signal Mode" 1 = no signal, 0 = current timings, 4 = selected timings.
+  ASSERT_TRUE(setV4l2ControlByName(*node, "DV Timings Signal Mode", 1));
+  EXPECT_TRUE(waitFor(
+      serviceAndDrain, [&] { return source->health().state == SourceState::kLost; }, 5s))
+      << "the signal went but the source stayed live";
+  EXPECT_TRUE(source->recovering());
+  ASSERT_TRUE(setV4l2ControlByName(*node, "DV Timings Signal Mode", 0));
+  const auto delivered = source->framesDelivered();
+  EXPECT_TRUE(waitFor(
+      serviceAndDrain,
+      [&] { return source->health().state == SourceState::kLive && source->framesDelivered() > delivered + 2; }, 10s))
+      << "the signal came back but the stream did not";
+  // Another resolution: pick a different entry of the "DV Timings" menu, then select it.
+  bool changed = false;
+  for (int entry = 1; entry < 8 && !changed; ++entry) {
+    if (!setV4l2ControlByName(*node, "DV Timings", entry)) continue;
+    if (!setV4l2ControlByName(*node, "DV Timings Signal Mode", 4)) break;
+    changed = waitFor(
+        serviceAndDrain,
+        [&] { return source->mode().width != before.width && source->health().state == SourceState::kLive; }, 5s);
+  }
+  EXPECT_TRUE(changed) << "no resolution change was renegotiated";
+  source->close();
+}
+
+TEST(V4l2Hardware, EnumerationDescribesTheWebcam) {
+  const auto node = test::vlabEnv("BASALT_VLAB_V4L2_WEBCAM");
+  if (!node) GTEST_SKIP() << test::needsVlab("BASALT_VLAB_V4L2_WEBCAM (vivid webcam input)");
+  auto d = describeV4l2Device(*node);
+  ASSERT_TRUE(d) << d.error().describe();
+  EXPECT_FALSE(d->modes.empty());
+  EXPECT_TRUE(d->streaming);
+  V4l2Provider provider;
+  bool listed = false;
+  for (const auto& c : provider.enumerate()) listed = listed || c.info.path == *node;
+  EXPECT_TRUE(listed);
+}
+
+/// Unplugs and replugs a gadget with the lab's control program.
+bool gadgetCtl(const std::string& what, const std::string& gadget) {
+  const auto ctl = test::vlabEnv("BASALT_VLAB_GADGET_CTL");
+  if (!ctl) return false;
+  const std::string cmd = *ctl + " " + what + " " + gadget;
+  return std::system(cmd.c_str()) == 0;
+}
+
+void hotplugRoundTrip(DeviceKind kind, const std::string& gadget, DeviceMatch match,
+                      std::unique_ptr<DeviceProvider> provider) {
+  SystemClock clock;
+  BoundedQueue<Event> events(4096);
+  DeviceManager manager(clock, events);
+  manager.addProvider(std::move(provider));
+  DeviceRequest r;
+  r.name = "device";
+  r.kind = kind;
+  r.match = std::move(match);
+  ASSERT_TRUE(manager.request(r));
+  auto monitor = UdevMonitor::create();
+  if (monitor) (*monitor)->start([&](HotplugEvent e) { manager.notifyHotplug(std::move(e)); });
+  manager.start(10ms);
+  auto state = [&] { return manager.status()[0].state; };
+  auto idle = [] {};
+  ASSERT_TRUE(waitFor(idle, [&] { return state() == DeviceState::kLive; }, 10s)) << manager.status()[0].lastError;
+  ASSERT_TRUE(gadgetCtl("unplug", gadget));
+  EXPECT_TRUE(waitFor(idle, [&] { return state() == DeviceState::kLost || state() == DeviceState::kReopening; }, 10s));
+  ASSERT_TRUE(gadgetCtl("plug", gadget));
+  EXPECT_TRUE(waitFor(
+      idle, [&] { return state() == DeviceState::kLive; }, 20s))
+      << "not live again after the replug: " << manager.status()[0].lastError;
+  manager.stop();
+  if (monitor) (*monitor)->stop();
+}
+
+TEST(HotplugHardware, DialGadgetUnpluggedAndReplugged) {
+  const auto ids = test::vlabEnv("BASALT_VLAB_HID_DIAL");
+  if (!ids || !test::vlabEnv("BASALT_VLAB_GADGET_CTL")) {
+    GTEST_SKIP() << test::needsVlab("BASALT_VLAB_HID_DIAL and BASALT_VLAB_GADGET_CTL");
+  }
+  DeviceMatch m;
+  m.backend = "hid";
+  ASSERT_TRUE(parseVendorProduct(*ids, m));
+  hotplugRoundTrip(DeviceKind::kDialBox, "dial", m, std::make_unique<HidProvider>());
+}
+
+TEST(HotplugHardware, PowerMateGadgetUnpluggedAndReplugged) {
+  if (!test::vlabEnv("BASALT_VLAB_HID_POWERMATE") || !test::vlabEnv("BASALT_VLAB_GADGET_CTL")) {
+    GTEST_SKIP() << test::needsVlab("BASALT_VLAB_HID_POWERMATE and BASALT_VLAB_GADGET_CTL");
+  }
+  DeviceMatch m;
+  m.backend = "hid";
+  m.vendor = 0x077d;
+  m.product = 0x0410;
+  hotplugRoundTrip(DeviceKind::kDialBox, "powermate", m, std::make_unique<HidProvider>());
+}
+
+TEST(HotplugHardware, UvcGadgetUnpluggedAndReplugged) {
+  const auto node = test::vlabEnv("BASALT_VLAB_V4L2_UVC");
+  if (!node || !test::vlabEnv("BASALT_VLAB_GADGET_CTL")) {
+    GTEST_SKIP() << test::needsVlab("BASALT_VLAB_V4L2_UVC and BASALT_VLAB_GADGET_CTL");
+  }
+  DeviceMatch m;
+  m.backend = "v4l2";
+  m.name = "";
+  auto d = describeV4l2Device(*node);
+  ASSERT_TRUE(d) << d.error().describe();
+  m.name = d->card;  // the node may get another number after the replug: match by name
+  hotplugRoundTrip(DeviceKind::kVideoSource, "uvc", m, std::make_unique<V4l2Provider>());
+}
+
+TEST(UdevHotplug, MonitorStartsOrSaysWhy) {
+  auto monitor = UdevMonitor::create();
+  if (!monitor) {
+    EXPECT_NE(monitor.error().message().find("retry"), std::string::npos) << monitor.error().describe();
+    GTEST_SKIP() << "no udev here: " << monitor.error().describe();
+  }
+  (*monitor)->start([](const HotplugEvent&) {});
+  (*monitor)->stop();
+  (*monitor)->stop();  // twice is safe
+}
+
+}  // namespace
+}  // namespace basalt::devices

@@ -1,0 +1,130 @@
+// Every movie under ../shared/testdata/video, each its own case: it opens with the expected
+// size, pixel aspect and frame rate, plays through to its last frame in order (frame count
+// exact), or fails with the expected message naming the file and the cause.
+// Example failures: a container's text tracks stalling the pipeline (many_tracks.mp4); B-frame
+// reordering showing frames out of order; an elementary stream with no duration reporting no
+// frames; a truncated file hanging the player; an unsupported codec reaching the screen as a
+// crash or a silent black texture.
+
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <string>
+
+#include "media/movie_player.h"
+#include "support/movie_playback.h"
+#include "support/test_paths.h"
+
+namespace basalt::media {
+namespace {
+
+struct MovieCase {
+  const char* file;  // under testdata/video
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  double fps = 0;
+  std::int64_t frames = 0;  // frames in the file (last frame number + 1)
+  double pixelAspect = 1;
+  bool gapsAllowed = false;     // damaged frames the decoder drops
+  const char* error = nullptr;  // for files that must fail: part of the message
+};
+
+void PrintTo(const MovieCase& c, std::ostream* os) { *os << c.file; }
+
+class MovieFile : public ::testing::TestWithParam<MovieCase> {};
+
+TEST_P(MovieFile, PlaysAsExpectedOrFailsClearly) {
+  const MovieCase& c = GetParam();
+  const std::filesystem::path data = test::testdataDir();
+  if (data.empty()) GTEST_SKIP() << "no ../shared/testdata here (set BASALT_TESTDATA)";
+  const std::filesystem::path path = data / "video" / c.file;
+  auto player = MoviePlayer::create({});
+  ASSERT_TRUE(player) << player.error().describe();
+  ASSERT_TRUE((*player)->load(path));
+  auto info = (*player)->waitUntilLoaded(std::chrono::seconds(20));
+  if (c.error) {
+    ASSERT_FALSE(info) << c.file << " played but must fail";
+    const std::string message = info.error().describe();
+    EXPECT_NE(message.find(c.error), std::string::npos) << message;
+    EXPECT_NE(message.find(path.string()), std::string::npos) << "the message must name the file: " << message;
+    EXPECT_EQ((*player)->state(), MovieState::kFailed);
+    // The player is reusable after a failure.
+    ASSERT_TRUE((*player)->load(data / "video/h264/stub_h264.mp4"));
+    EXPECT_TRUE((*player)->waitUntilLoaded(std::chrono::seconds(20)));
+    return;
+  }
+  ASSERT_TRUE(info) << info.error().describe();
+  EXPECT_EQ(info->width, c.width);
+  EXPECT_EQ(info->height, c.height);
+  EXPECT_NEAR(info->fps, c.fps, 0.01);
+  EXPECT_NEAR(info->pixelAspect, c.pixelAspect, 0.01);
+  EXPECT_NE(info->format, PixelFormat::kUnknown);
+  (*player)->play();
+  Nanos t{0};
+  const test::Playthrough run = test::playFor(**player, t, info->frameDuration, c.frames * 2 + 50);
+  ASSERT_TRUE(run.reachedEnd) << "did not reach the end";
+  ASSERT_FALSE(run.frames.empty());
+  EXPECT_EQ(run.frames.front(), 0);
+  EXPECT_EQ(run.frames.back(), c.frames - 1);
+  EXPECT_EQ((*player)->frameCount(), c.frames);
+  EXPECT_TRUE((*player)->info().frameCountExact);
+  for (std::size_t i = 1; i < run.frames.size(); ++i) {
+    if (c.gapsAllowed) {
+      ASSERT_GT(run.frames[i], run.frames[i - 1]) << "frame " << i;
+    } else {
+      ASSERT_EQ(run.frames[i], run.frames[i - 1] + 1) << "frame " << i;
+    }
+  }
+  if (!c.gapsAllowed) {
+    EXPECT_EQ(static_cast<std::int64_t>(run.frames.size()), c.frames);
+  }
+}
+
+// Sizes, rates and counts as MANIFEST.md describes the files (counts as decoded: the
+// container's duration rounds; elementary streams have none).
+INSTANTIATE_TEST_SUITE_P(
+    Testdata, MovieFile,
+    ::testing::Values(
+        MovieCase{"mjpeg/stub_mjpeg.avi", 160, 120, 10, 3}, MovieCase{"mpeg1/pypy_test.mpg", 480, 360, 29.97, 181},
+        MovieCase{"mpeg1/pypy_blackbg.mpg", 320, 240, 25, 113},
+        MovieCase{"mpeg1/weird_aspect.small.mpg", 352, 288, 25, 37, 64.0 / 45.0, true},
+        MovieCase{"mpeg1/test-sample-320x240-29.970fps-14.014s.m1v", 320, 240, 29.97, 420},
+        MovieCase{"h264/stub_h264.mp4", 160, 120, 10, 5, 2.0},
+        MovieCase{"h264/awesome_widescreen.mov", 320, 180, 10, 72},
+        MovieCase{"h264/many_tracks.mp4", 640, 360, 10, 101},
+        MovieCase{"h264/test-sample-636x360-25fps-53.76s.mp4", 636, 360, 25, 1344},
+        MovieCase{"h264/annexb/SVA_BA2_D.264", 176, 144, 25, 17},
+        MovieCase{"h264/annexb/BA_MW_D.264", 176, 144, 25, 100},
+        MovieCase{"h264/annexb/MR1_BT_A.h264", 176, 144, 25, 62},
+        MovieCase{"h264/annexb/SarVui.264", 176, 144, 25, 17, 80.0 / 33.0},
+        MovieCase{"h264/annexb/Static.264", 152, 100, 25, 10},
+        MovieCase{"h264/annexb/Cisco_Men_whisper_640x320_CABAC_Bframe_9.264", 640, 320, 25, 9},
+        MovieCase{"h264/annexb/test_scalinglist_jm.264", 320, 192, 25, 5},
+        MovieCase{"h264/annexb/QCIF_2P_I_allIPCM.264", 176, 144, 25, 2},
+        // Error cases of the conformance suite: the decoder conceals, the show goes on.
+        MovieCase{"h264/annexb/BA_MW_D_IDR_LOST.264", 176, 144, 25, 97},
+        MovieCase{"h264/annexb/Error_I_P.264", 352, 288, 25, 6},
+        MovieCase{"negative/broken.mp4", 0, 0, 0, 0, 1, false, "no 'moov' atom"},
+        MovieCase{"negative/Mpeg4_smallest.mp4", 0, 0, 0, 0, 1, false, "no playable streams"},
+        MovieCase{"negative/AudioVideoInterleave.avi", 0, 0, 0, 0, 1, false, "unsupported video codec: MPEG-4 Video"},
+        MovieCase{"negative/stub_mp4v.mp4", 0, 0, 0, 0, 1, false, "unsupported video codec: MPEG-4 Video"}),
+    [](const ::testing::TestParamInfo<MovieCase>& param) {
+      std::string name = param.param.file;
+      for (char& ch : name) {
+        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+      }
+      return name;
+    });
+
+TEST(MovieFileErrors, MissingFileFailsAtOnceNamingIt) {
+  auto player = MoviePlayer::create({});
+  ASSERT_TRUE(player);
+  auto r = (*player)->load("/nonexistent/movie.mp4");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code(), Errc::kNotFound);
+  EXPECT_NE(r.error().describe().find("/nonexistent/movie.mp4"), std::string::npos);
+  EXPECT_EQ((*player)->frameAt(Nanos{0}).get(), nullptr);
+}
+
+}  // namespace
+}  // namespace basalt::media

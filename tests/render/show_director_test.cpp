@@ -1,0 +1,337 @@
+// The show director in the frame loop, headless on a ManualClock, every frame read back: a
+// reload takes over between two frames and never shows a black frame (and a broken manifest
+// leaves the old show playing); dials turn the show through their bindings and buttons move the
+// playlist; a visitor wakes the attract loop; items this build cannot play are skipped, and when
+// none can, the screen is black rather than stuck; outside opening hours the display goes off
+// (black where the output has no display to switch); a stream texture shows its fallback.
+// Example failures: a black frame while the new show loads; a reload error that stops the show;
+// a button that does nothing; an unplayable item retried every frame.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <thread>
+
+#include "kiosk/frame_loop.h"
+#include "kiosk/manifest.h"
+#include "kiosk/show_director.h"
+#include "kiosk/show_loader.h"
+#include "kiosk/status_board.h"
+#include "kiosk/time_zone.h"
+#include "render/output.h"
+#include "render/renderer.h"
+#include "runtime/event_loop.h"
+#include "support/test_paths.h"
+
+namespace basalt::kiosk {
+namespace {
+
+using namespace std::chrono_literals;
+
+/// Counts the lit pixels of every frame drawn.
+class FrameRecorder final : public FrameParticipant {
+ public:
+  Result<void> afterDraw(const FrameContext& /*frame*/, render::Output& output) override {
+    if (auto r = output.readBack(image_); !r) return r;
+    std::size_t lit = 0;
+    for (std::size_t i = 0; i < image_.pixels.size(); i += 4) {
+      if (image_.pixels[i] + image_.pixels[i + 1] + image_.pixels[i + 2] > 30) ++lit;
+    }
+    lit_.push_back(lit);
+    return {};
+  }
+  [[nodiscard]] const std::vector<std::size_t>& lit() const { return lit_; }
+  [[nodiscard]] std::size_t blackFrames() const {
+    return static_cast<std::size_t>(std::count(lit_.begin(), lit_.end(), std::size_t{0}));
+  }
+
+ private:
+  Image image_;
+  std::vector<std::size_t> lit_;
+};
+
+/// A show run headless on a ManualClock, frame by frame.
+class Harness {
+ public:
+  explicit Harness(const std::string& name, WallTime wallStart = WallTime{std::chrono::hours(24 * 20000)})
+      : dir_(test::scratchDir("director-" + name)), clock_(Nanos{0}, wallStart), board_(wallStart, 30) {}
+
+  bool open(std::string& why) {
+    auto output = render::createHeadlessOutput({48, 48});
+    if (!output) {
+      why = output.error().describe();
+      return false;
+    }
+    output_ = std::move(*output);
+    renderer_ = std::move(*render::Renderer::create());
+    loop_ = std::move(*runtime::EventLoop::create(clock_));
+    return true;
+  }
+
+  void write(const std::string& manifest) { std::ofstream(dir_ / "show.toml") << manifest; }
+  [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
+
+  /// Reads the manifest and installs it.
+  ::testing::AssertionResult install(const std::string& manifest) {
+    write(manifest);
+    Diagnostics d;
+    auto m = readManifest(dir_ / "show.toml", d);
+    if (!m) return ::testing::AssertionFailure() << d.format();
+    auto loaded = loadShow(std::move(*m), clock_);
+    if (!loaded) return ::testing::AssertionFailure() << loaded.error().describe();
+    director_ = std::make_unique<ShowDirector>(
+        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30});
+    director_->install(std::move(*loaded), clock_.now(), std::nullopt);
+    return ::testing::AssertionSuccess();
+  }
+
+  /// Runs `frames` frames at 30 fps, recording each.
+  void run(std::int64_t frames) {
+    FrameLoop loop({30, frames}, clock_, &clock_, *loop_, show_, *output_, *renderer_);
+    loop.addParticipant(*director_);
+    loop.addParticipant(recorder_);
+    auto stats = loop.run();
+    ASSERT_TRUE(stats) << stats.error().describe();
+  }
+
+  /// Runs frames until `done` or `limit` frames; the loader thread works in real time meanwhile.
+  template <typename Done>
+  bool runUntil(Done done, int limit = 600) {
+    for (int i = 0; i < limit; ++i) {
+      if (done()) return true;
+      run(1);
+      std::this_thread::sleep_for(2ms);
+    }
+    return done();
+  }
+
+  ShowDirector& director() { return *director_; }
+  StatusBoard& board() { return board_; }
+  FrameRecorder& recorder() { return recorder_; }
+  runtime::Show& show() { return show_; }
+  render::Renderer& renderer() { return *renderer_; }
+  [[nodiscard]] std::string item() const {
+    const auto* p = director_->policy();
+    return p && p->current().item ? p->current().item->name : std::string();
+  }
+
+ private:
+  std::filesystem::path dir_;
+  ManualClock clock_;
+  StatusBoard board_;
+  std::unique_ptr<render::Output> output_;
+  std::unique_ptr<render::Renderer> renderer_;
+  std::unique_ptr<runtime::EventLoop> loop_;
+  BoundedQueue<Event> events_{256};
+  runtime::Show show_;
+  std::unique_ptr<ShowDirector> director_;
+  FrameRecorder recorder_;
+};
+
+#define OPEN_OR_SKIP(h)                                                  \
+  do {                                                                   \
+    std::string why;                                                     \
+    if (!(h).open(why)) GTEST_SKIP() << "no headless EGL here: " << why; \
+  } while (false)
+
+constexpr const char* kCube = R"(
+[show]
+name = "A"
+entry = "default"
+)";
+
+TEST(ShowDirector, AReloadTakesOverWithoutABlackFrame) {
+  Harness h("reload");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(h.install(kCube));
+  h.run(10);
+  h.write(R"(
+[show]
+name = "B"
+entry = "default"
+
+[[kiosk.playlist]]
+name = "cube again"
+entry = "default"
+)");
+  h.director().requestReload();
+  ASSERT_TRUE(h.runUntil([&] { return h.director().reloadsApplied() == 1; })) << "the reload never took over";
+  h.run(10);
+  EXPECT_EQ(h.item(), "cube again");
+  EXPECT_EQ(h.board().snapshot(WallTime{}).show.name, "B");
+  EXPECT_EQ(h.recorder().blackFrames(), 0u) << "every frame before, during and after the reload shows the cube";
+
+  // A broken manifest: the reload fails, the show plays on unchanged.
+  h.write("[show]\nentry = \n");
+  h.director().requestReload();
+  ASSERT_TRUE(h.runUntil([&] { return h.director().reloadsFailed() == 1; }));
+  h.run(10);
+  EXPECT_EQ(h.item(), "cube again");
+  EXPECT_EQ(h.recorder().blackFrames(), 0u);
+  const StatusSnapshot s = h.board().snapshot(WallTime{});
+  EXPECT_EQ(s.reloadFailures, 1);
+  EXPECT_NE(s.lastReload.find("failed"), std::string::npos) << s.lastReload;
+}
+
+TEST(ShowDirector, DialsTurnTheShowThroughTheirBindings) {
+  const std::string manifest = R"(
+[show]
+entry = "default"
+[devices.dials]
+kind = "dial_box"
+backend = "synthetic"
+loop = false
+script = [ { at = "0.1s", dial = 1, turns = 0.25 }, { at = "0.2s", dial = 5, turns = 1.0 } ]
+[[bindings]]
+device = "dials"
+dial = 1
+action = "rotate_y"
+)";
+  Harness turned("dials");
+  OPEN_OR_SKIP(turned);
+  ASSERT_TRUE(turned.install(manifest));
+  Harness still("dials-still");
+  OPEN_OR_SKIP(still);
+  ASSERT_TRUE(still.install(kCube));
+  turned.run(12);
+  still.run(12);
+  // The same free-run motion, plus a quarter turn about Y: the matrices differ.
+  const Mat4& a = turned.show().position().global;
+  const Mat4& b = still.show().position().global;
+  float difference = 0;
+  for (int i = 0; i < 16; ++i)
+    difference += std::abs(a.m[static_cast<std::size_t>(i)] - b.m[static_cast<std::size_t>(i)]);
+  EXPECT_GT(difference, 0.5f) << "the dial's quarter turn is in the show";
+  // Dial 5 (LAVA's translate Y) is not bound in this show, which binds dial 1 only: no move.
+  EXPECT_FLOAT_EQ(a.m[13], b.m[13]);
+  const StatusSnapshot s = turned.board().snapshot(WallTime{});
+  ASSERT_EQ(s.devices.size(), 1u);
+  EXPECT_EQ(s.devices[0].state, "live");
+}
+
+TEST(ShowDirector, ButtonsMoveThePlaylistAndInputWakesTheAttractLoop) {
+  Harness h("buttons");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(h.install(R"(
+[devices.dials]
+kind = "dial_box"
+backend = "synthetic"
+loop = false
+script = [ { at = "0.5s", dial = 0, turns = 0.01 }, { at = "1s", button = 2 }, { at = "1.1s", button = 2, pressed = false } ]
+[[bindings]]
+device = "dials"
+button = 2
+action = "next"
+[[kiosk.playlist]]
+name = "one"
+entry = "default"
+duration = "1h"
+[[kiosk.playlist]]
+name = "two"
+entry = "default"
+duration = "1h"
+[kiosk.attract]
+idle_timeout = "5s"
+items = [ { entry = "default", name = "attract" } ]
+)"));
+  EXPECT_EQ(h.item(), "attract");
+  h.run(18);  // 0.6 s: the dial turned at 0.5 s
+  EXPECT_EQ(h.item(), "one") << "a visitor's touch starts the playlist";
+  h.run(18);  // 1.2 s: the button was pressed at 1 s
+  EXPECT_EQ(h.item(), "two");
+  h.run(std::int64_t{30} * 6);  // 7.2 s: five seconds after the last touch
+  EXPECT_EQ(h.item(), "attract");
+  EXPECT_EQ(h.recorder().blackFrames(), 0u);
+}
+
+TEST(ShowDirector, ItemsThisBuildCannotPlayAreSkipped) {
+  Harness h("unplayable");
+  OPEN_OR_SKIP(h);
+  std::ofstream(h.dir() / "tour.mdl") << "draw\n";
+  std::ofstream(h.dir() / "wall.sce") << "import wall.obj\n";
+  ASSERT_TRUE(h.install(R"(
+[[kiosk.playlist]]
+name = "tour"
+entry = "tour.mdl"
+[[kiosk.playlist]]
+name = "cube"
+entry = "default"
+duration = "10s"
+)"));
+  EXPECT_EQ(h.item(), "cube") << "the script cannot play in this build: the cube plays";
+  h.run(5);
+  EXPECT_EQ(h.recorder().blackFrames(), 0u);
+  const StatusSnapshot s = h.board().snapshot(WallTime{});
+  bool said = false;
+  for (const auto& r : s.lastErrors) said = said || r.message.find("'tour' cannot play") != std::string::npos;
+  EXPECT_TRUE(said) << "the operator is told why";
+
+  Harness none("none-playable");
+  OPEN_OR_SKIP(none);
+  std::ofstream(none.dir() / "tour.mdl") << "draw\n";
+  std::ofstream(none.dir() / "wall.sce") << "import wall.obj\n";
+  ASSERT_TRUE(none.install(R"(
+[[kiosk.playlist]]
+name = "tour"
+entry = "tour.mdl"
+[[kiosk.playlist]]
+name = "wall"
+entry = "wall.sce"
+duration = "10s"
+)"));
+  none.run(5);
+  EXPECT_EQ(none.item(), "");
+  EXPECT_EQ(none.recorder().blackFrames(), 5u) << "nothing can play: black, and the loop goes on";
+  EXPECT_EQ(none.board().snapshot(WallTime{}).show.display, "black");
+}
+
+TEST(ShowDirector, OutsideOpeningHoursTheDisplayGoesDark) {
+  // Monday 2026-03-23 12:00 UTC; the show opens on Tuesdays only.
+  const WallTime monday{std::chrono::seconds(daysFromCivil(2026, 3, 23) * 86400 + std::int64_t{12} * 3600)};
+  Harness h("closed", monday);
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(h.install(R"(
+[show]
+entry = "default"
+[kiosk.schedule]
+timezone = "UTC"
+tuesday = "10:00-18:00"
+outside = "display_off"
+)"));
+  h.run(3);
+  const StatusSnapshot s = h.board().snapshot(WallTime{});
+  EXPECT_EQ(s.show.mode, "closed");
+  EXPECT_EQ(s.show.display, "off");
+  EXPECT_EQ(h.recorder().blackFrames(), 3u) << "the headless output has no display to switch off: black instead";
+  bool warned = false;
+  for (const auto& r : s.lastErrors) warned = warned || r.message.find("showing black instead") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST(ShowDirector, AStreamTextureShowsItsFallback) {
+  Harness h("fallback");
+  OPEN_OR_SKIP(h);
+  std::filesystem::copy_file(test::sourceDir() / "configs/shows/video-wall/screens.png", h.dir() / "bars.png");
+  std::ofstream(h.dir() / "loop.webm") << "not a movie";
+  ASSERT_TRUE(h.install(R"(
+[media.loop]
+kind = "movie"
+file = "loop.webm"
+[textures."screens.png"]
+source = "loop"
+fallback = "bars.png"
+[textures.plain]
+file = "bars.png"
+)"));
+  const render::TextureView* screens = h.renderer().textures().find("screens.png");
+  ASSERT_NE(screens, nullptr) << "the fallback stands in for the movie";
+  EXPECT_EQ(screens->size.width, 128u);
+  EXPECT_NE(h.renderer().textures().find("plain"), nullptr);
+  const StatusSnapshot s = h.board().snapshot(WallTime{});
+  ASSERT_EQ(s.streams.size(), 1u);
+  EXPECT_EQ(s.streams[0].state, "absent");
+  EXPECT_NE(s.streams[0].message.find("showing the fallback image"), std::string::npos) << s.streams[0].message;
+}
+
+}  // namespace
+}  // namespace basalt::kiosk

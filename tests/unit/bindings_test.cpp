@@ -1,0 +1,89 @@
+// Bindings beyond LAVA's table: the show's gain, acceleration (a fast turn goes further than the
+// same turn made slowly), per-dial overrides and inversion, absolute dials turned into motion,
+// shuttle rings that keep turning while held and stop when their device is lost, and the action
+// names a manifest uses.
+// Example failures: acceleration applied to slow turns; an absolute dial's first reading jumping
+// the object; a shuttle ring that keeps the object spinning after the Shuttle is unplugged.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "runtime/bindings.h"
+
+namespace basalt::runtime {
+namespace {
+
+float angleY(const Show& show) {
+  // rotationY(a): m[8] = sin(a) (column-major third column, first row).
+  return std::atan2(show.position().global.m[8], show.position().global.m[0]) * 180.0f / 3.14159265f;
+}
+
+Event dial(std::uint16_t index, double turns, Nanos t = Nanos{0}, EventKind kind = EventKind::kDialDelta) {
+  return Event{t, 1, kind, index, turns};
+}
+
+TEST(BindingsExtended, GainScalesEveryDialAndInvertFlips) {
+  Bindings b = Bindings::lavaDefaults();
+  b.setGain(0.5);
+  Show show;
+  ASSERT_TRUE(b.apply(dial(1, 0.25), show));
+  EXPECT_NEAR(angleY(show), 45, 1e-3);
+  DialBinding d = b.dial(1);
+  d.invert = true;
+  b.setDial(1, d);
+  ASSERT_TRUE(b.apply(dial(1, 0.25), show));
+  EXPECT_NEAR(angleY(show), 0, 1e-3);
+}
+
+TEST(BindingsExtended, AccelerationRewardsSpeedOnly) {
+  Bindings b = Bindings::lavaDefaults();
+  b.setAcceleration(1.0);
+  Show slow;
+  // Ten slow steps of 1/100 turn, a second apart: speed 0.04 turns/s (one step per 0.25 s cap).
+  for (int i = 0; i < 10; ++i) b.apply(dial(1, 0.01, std::chrono::seconds(i)), slow);
+  b.reset();
+  Show fast;
+  // The same ten steps 5 ms apart: 2 turns per second.
+  for (int i = 0; i < 10; ++i) b.apply(dial(1, 0.01, std::chrono::milliseconds(5 * i)), fast);
+  EXPECT_NEAR(angleY(slow), 36 * 1.04, 0.05);
+  EXPECT_GT(angleY(fast), angleY(slow) * 2) << "a fast turn must go further";
+}
+
+TEST(BindingsExtended, PerDialOverrideAndNames) {
+  Bindings b = Bindings::lavaDefaults();
+  b.setDial(7, {Action::kRotateY, 180});  // LAVA's idle dial 7 now turns Y, half as fast
+  Show show;
+  ASSERT_TRUE(b.apply(dial(7, 0.5), show));
+  EXPECT_NEAR(angleY(show), 90, 1e-3);
+  EXPECT_EQ(actionByName("translate_z"), Action::kTranslateZ);
+  EXPECT_EQ(actionName(Action::kScale), "scale");
+  EXPECT_FALSE(actionByName("spin"));
+  EXPECT_FALSE(b.apply(dial(40, 1.0), show)) << "dials past the table do nothing";
+}
+
+TEST(BindingsExtended, AbsoluteDialsMoveByTheirChange) {
+  Bindings b = Bindings::lavaDefaults();
+  Show show;
+  EXPECT_FALSE(b.apply(dial(1, 0.6, Nanos{0}, EventKind::kDialAbsolute), show))
+      << "the first reading only sets the origin";
+  EXPECT_NEAR(angleY(show), 0, 1e-3);
+  ASSERT_TRUE(b.apply(dial(1, 0.85, Nanos{0}, EventKind::kDialAbsolute), show));
+  EXPECT_NEAR(angleY(show), 90, 1e-3);
+}
+
+TEST(BindingsExtended, ShuttleTurnsWhileHeldAndStopsWhenItsDeviceIsLost) {
+  Bindings b = Bindings::lavaDefaults();
+  b.setShuttleTurnsPerSecond(0.5);
+  Show show;
+  b.apply(Event{Nanos{0}, 9, EventKind::kShuttle, 1, 0.5}, show);  // ring half right on dial 1 (Y)
+  ASSERT_TRUE(b.advance(std::chrono::milliseconds(500), show));    // 0.5 * 0.5 * 0.5 s = 1/8 turn
+  EXPECT_NEAR(angleY(show), 45, 1e-3);
+  b.apply(Event{Nanos{0}, 3, EventKind::kDeviceState, 0, 0}, show);  // another device lost: no effect
+  EXPECT_TRUE(b.advance(std::chrono::milliseconds(100), show));
+  b.apply(Event{Nanos{0}, 9, EventKind::kDeviceState, 0, 0}, show);  // the Shuttle is unplugged
+  EXPECT_FALSE(b.advance(std::chrono::seconds(1), show)) << "nothing keeps spinning";
+}
+
+}  // namespace
+}  // namespace basalt::runtime

@@ -1,0 +1,89 @@
+// The deployment files in configs/: the systemd unit is what the issue asks of it (Type=notify,
+// a watchdog, Restart=always, sandboxing, device access limited to the show's devices) and
+// systemd itself accepts every line of it; the udev rule parses and covers the dial boxes and
+// cameras Basalt supports.
+// Example failures: a misspelt directive that systemd ignores with a warning (the sandbox
+// silently weaker); a udev line with a typo that udev skips (the dial box unreadable on site).
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "support/process.h"
+#include "support/test_paths.h"
+
+namespace basalt {
+namespace {
+
+std::string read(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(SystemdUnit, HasWhatAKioskServiceNeeds) {
+  const std::string unit = read(test::sourceDir() / "configs/systemd/basalt.service");
+  for (const char* line : {"Type=notify", "WatchdogSec=10", "Restart=always", "NoNewPrivileges=yes",
+                           "ProtectSystem=strict", "ProtectHome=yes", "PrivateTmp=yes", "DevicePolicy=closed",
+                           "DeviceAllow=char-drm rw", "DeviceAllow=char-video4linux rw", "DeviceAllow=char-hidraw rw",
+                           "DeviceAllow=char-usb_device rw", "StateDirectory=basalt",
+                           "ExecReload=/bin/kill -HUP $MAINPID", "StartLimitIntervalSec=0", "CapabilityBoundingSet="}) {
+    EXPECT_NE(unit.find(std::string("\n") + line + "\n"), std::string::npos) << line;
+  }
+  EXPECT_EQ(unit.find("MemoryDenyWriteExecute=yes"), std::string::npos)
+      << "Mesa's software renderer compiles shaders at run time";
+}
+
+TEST(SystemdUnit, SystemdAcceptsEveryLine) {
+  if (::access("/usr/bin/systemd-analyze", X_OK) != 0) GTEST_SKIP() << "systemd-analyze is not installed";
+  // systemd-analyze checks that ExecStart's program exists: point it at the build.
+  std::string unit = read(test::sourceDir() / "configs/systemd/basalt.service");
+  unit = std::regex_replace(unit, std::regex("/usr/bin/basalt"), (test::binaryDir() / "basalt").string());
+  const auto dir = test::scratchDir("configs-unit");
+  std::ofstream(dir / "basalt.service") << unit;
+  const auto verify = test::run({"/usr/bin/systemd-analyze", "verify", (dir / "basalt.service").string()});
+  EXPECT_EQ(verify.exitCode, 0) << verify.output;
+  EXPECT_EQ(verify.output.find("basalt.service:"), std::string::npos) << "a line systemd ignores: " << verify.output;
+  const auto security =
+      test::run({"/usr/bin/systemd-analyze", "security", "--offline=true", (dir / "basalt.service").string()});
+  std::smatch m;
+  ASSERT_TRUE(
+      std::regex_search(security.output, m, std::regex(R"(Overall exposure level for basalt\.service: ([0-9.]+))")))
+      << security.output;
+  EXPECT_LT(std::stod(m[1]), 5.0) << "systemd rates the sandbox: " << m[0];
+}
+
+TEST(UdevRule, EveryLineParsesAndTheSupportedDevicesAreCovered) {
+  const std::string rules = read(test::sourceDir() / "configs/udev/70-basalt.rules");
+  // KEY or KEY{attr}, an operator, a quoted value; pairs separated by commas.
+  const std::regex pair(
+      R"re(\s*(ACTION|SUBSYSTEM|KERNEL|KERNELS|DRIVERS|ENV\{[A-Z_]+\}|ATTR\{[a-zA-Z_]+\}|ATTRS\{[a-zA-Z_]+\}|GROUP|MODE|TAG|GOTO|LABEL)(==|!=|\+=|=)"[^"]*"\s*)re");
+  std::istringstream in(rules);
+  std::string line;
+  int number = 0;
+  int rulesSeen = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line.starts_with("#")) continue;
+    std::istringstream parts(line);
+    std::string part;
+    while (std::getline(parts, part, ',')) {
+      EXPECT_TRUE(std::regex_match(part, pair)) << "line " << number << ": '" << part << "'";
+    }
+    ++rulesSeen;
+  }
+  EXPECT_GE(rulesSeen, 8);
+  for (const char* device : {"ATTR{idVendor}==\"077d\", ATTR{idProduct}==\"0410\"", "0003:256C:0060", "0005:256C:8251",
+                             "0005:045E:091B", "0003:0B33:0020", "SUBSYSTEM==\"video4linux\""}) {
+    EXPECT_NE(rules.find(device), std::string::npos) << device;
+  }
+  EXPECT_NE(rules.find("LABEL=\"basalt_end\""), std::string::npos) << "the GOTO's label";
+}
+
+}  // namespace
+}  // namespace basalt

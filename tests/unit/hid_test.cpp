@@ -1,0 +1,327 @@
+// HID report descriptors and dial decoding: the parser, the PowerMate, Shuttle and generic
+// profiles, Basalt's virtual dial box, and every recording in ../shared/testdata/hid (one test
+// case each), including damaged descriptors.
+// Example failures: the Surface Dial's rotation read from the wrong bits or at the wrong scale;
+// a Shuttle jog wrap from 255 to 0 read as -255 counts; a truncated descriptor that crashes the
+// parser instead of naming the byte; a Consumer Play/Pause key never reaching a button.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <vector>
+
+#include "devices/hid/dial_decoder.h"
+#include "devices/hid/report_descriptor.h"
+#include "sim/hid_recording.h"
+#include "support/test_paths.h"
+
+namespace basalt::devices {
+namespace {
+
+using hid::parseReportDescriptor;
+
+std::filesystem::path hidData(const std::string& name) {
+  const auto dir = test::testdataDir();
+  return dir.empty() ? std::filesystem::path{} : dir / "hid" / "udev-hid-bpf" / name;
+}
+
+sim::HidRecording loadOrSkip(const std::string& name) {
+  const auto path = hidData(name);
+  if (path.empty() || !std::filesystem::exists(path)) return {};
+  auto rec = sim::readHidRecording(path);
+  EXPECT_TRUE(rec) << (rec ? "" : rec.error().describe());
+  return rec ? *rec : sim::HidRecording{};
+}
+
+std::vector<Event> decodeAll(DialDecoder& d, std::span<const std::uint8_t> report) {
+  std::array<Event, DialDecoder::kMaxEventsPerReport> out;
+  const std::size_t n = d.decode(report, out);
+  return {out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n)};
+}
+
+// Every prefix of a real descriptor either parses or fails with a message; none crashes.
+void expectPrefixesSafe(const std::vector<std::uint8_t>& bytes) {
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    auto r = parseReportDescriptor(std::span(bytes).first(n), "prefix");
+    if (!r) {
+      EXPECT_FALSE(r.error().message().empty());
+    }
+  }
+}
+
+#define SKIP_WITHOUT(rec, name)                                                                      \
+  if ((rec).devices.empty()) {                                                                       \
+    GTEST_SKIP() << "../shared/testdata/hid/udev-hid-bpf/" name " is missing (set BASALT_TESTDATA)"; \
+  }
+
+TEST(HidTestdata, MicrosoftSurfaceDialMapsToOneDialAndAButton) {
+  const auto rec = loadOrSkip("microsoft_surface_dial_rdesc.hid");
+  SKIP_WITHOUT(rec, "microsoft_surface_dial_rdesc.hid");
+  ASSERT_EQ(rec.devices.size(), 1u);
+  const auto& dev = rec.devices[0];
+  EXPECT_EQ(dev.descriptor.size(), 488u);
+  EXPECT_EQ(dev.vendor, 0x045e);
+  EXPECT_EQ(dev.product, 0x091b);
+  auto d = DialDecoder::create(dev.vendor, dev.product, dev.descriptor, "surface dial");
+  ASSERT_TRUE(d) << d.error().describe();
+  EXPECT_EQ(d->profile(), DialProfile::kGenericHid);
+  ASSERT_GE(d->dialCount(), 1);
+  EXPECT_EQ(d->channels()[0].usage, hid::usages::kDial);
+  EXPECT_EQ(d->channels()[0].kind, EventKind::kDialDelta);
+  EXPECT_DOUBLE_EQ(d->channels()[0].countsPerTurn, 3600) << "the Resolution Multiplier's 3600 steps per turn";
+  EXPECT_GE(d->buttonCount(), 1);
+  // Report 1: button bit, touch bit, 6 pad bits, 16-bit dial, X, Y, width.
+  const std::vector<std::uint8_t> turn = {0x01, 0x01, 0x84, 0x03, 0, 0, 0, 0, 0};  // +900 = a quarter turn
+  auto events = decodeAll(*d, turn);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].kind, EventKind::kDialDelta);
+  EXPECT_DOUBLE_EQ(events[0].value, 0.25);
+  EXPECT_EQ(events[1].kind, EventKind::kButton);
+  EXPECT_EQ(events[1].value, 1);
+  const std::vector<std::uint8_t> back = {0x01, 0x00, 0x7c, 0xfc, 0, 0, 0, 0, 0};  // -900
+  events = decodeAll(*d, back);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_DOUBLE_EQ(events[0].value, -0.25);
+  EXPECT_EQ(events[1].value, 0) << "button released";
+  expectPrefixesSafe(dev.descriptor);
+}
+
+TEST(HidTestdata, HuionDial2PadDialMapsToDialZero) {
+  const auto rec = loadOrSkip("huion_dial2_q630m_rdescs.hid");
+  SKIP_WITHOUT(rec, "huion_dial2_q630m_rdescs.hid");
+  ASSERT_EQ(rec.devices.size(), 3u);
+  EXPECT_EQ(rec.devices[0].index, 0);
+  EXPECT_EQ(rec.devices[2].index, 2);
+  // D:0 is a vendor node with no controls: a clear refusal, not a crash.
+  auto vendorNode = DialDecoder::create(0x256c, 0x0060, rec.devices[0].descriptor, "huion D:0");
+  ASSERT_FALSE(vendorNode);
+  EXPECT_NE(vendorNode.error().message().find("no dial"), std::string::npos) << vendorNode.error().describe();
+  // D:1 is the pen: its X/Y are absolute axes, so they map to absolute dials.
+  auto pen = DialDecoder::create(0x256c, 0x0060, rec.devices[1].descriptor, "huion D:1");
+  ASSERT_TRUE(pen) << pen.error().describe();
+  EXPECT_EQ(pen->channels()[0].kind, EventKind::kDialAbsolute);
+  // D:2 is the pad: the dial of the puck pattern.
+  auto pad = DialDecoder::create(0x256c, 0x0060, rec.devices[2].descriptor, "huion D:2");
+  ASSERT_TRUE(pad) << pad.error().describe();
+  EXPECT_EQ(pad->channels()[0].usage, hid::usages::kDial);
+  EXPECT_DOUBLE_EQ(pad->channels()[0].countsPerTurn, 3600);
+  // Report 0x11: button bit, touch bit, 6 pad bits, dial (16 bit), 5 padding bytes.
+  std::vector<std::uint8_t> report = {0x11, 0x00, 0x0a, 0x00, 0, 0, 0, 0, 0};
+  auto events = decodeAll(*pad, report);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].index, 0);
+  EXPECT_DOUBLE_EQ(events[0].value, 10.0 / 3600);
+  for (const auto& d : rec.devices) expectPrefixesSafe(d.descriptor);
+}
+
+TEST(HidTestdata, HuionKeydialMiniReplaysWheelAndPlayPause) {
+  const auto rec = loadOrSkip("huion_keydial_mini050_bluetooth.hid");
+  SKIP_WITHOUT(rec, "huion_keydial_mini050_bluetooth.hid");
+  ASSERT_EQ(rec.devices.size(), 2u);
+  EXPECT_TRUE(rec.devices[0].reports.empty());
+  const auto& dev = rec.devices[1];
+  EXPECT_EQ(dev.bus, 5);
+  ASSERT_EQ(dev.reports.size(), 5u);
+  auto d = DialDecoder::create(dev.vendor, dev.product, dev.descriptor, "keydial D:1");
+  ASSERT_TRUE(d) << d.error().describe();
+  EXPECT_EQ(d->channels()[0].usage, hid::usages::kWheel) << "the knob arrives as the mouse wheel";
+  std::vector<Event> all;
+  for (const auto& r : dev.reports) {
+    for (Event e : decodeAll(*d, r.bytes)) {
+      e.time = r.time;
+      all.push_back(e);
+    }
+  }
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0].kind, EventKind::kDialDelta);
+  EXPECT_EQ(all[0].index, 0);
+  EXPECT_DOUBLE_EQ(all[0].value, -1.0 / kWheelCountsPerTurn);
+  EXPECT_EQ(all[0].time, Nanos{64'859'915'000});
+  EXPECT_EQ(all[1].kind, EventKind::kButton);
+  EXPECT_EQ(all[1].value, 1) << "Consumer Play/Pause pressed";
+  EXPECT_EQ(all[2].index, all[1].index);
+  EXPECT_EQ(all[2].value, 0);
+  // D:0, the puck pattern that never sends, still maps to a dial.
+  auto puck = DialDecoder::create(dev.vendor, dev.product, rec.devices[0].descriptor, "keydial D:0");
+  ASSERT_TRUE(puck) << puck.error().describe();
+  EXPECT_EQ(puck->channels()[0].usage, hid::usages::kDial);
+  for (const auto& dv : rec.devices) expectPrefixesSafe(dv.descriptor);
+}
+
+TEST(HidDescriptor, MalformedDescriptorsNameTheByte) {
+  struct Case {
+    std::vector<std::uint8_t> bytes;
+    const char* expect;
+  };
+  const std::vector<Case> cases = {
+      {{}, "empty"},
+      {{0x05, 0x01, 0x26, 0xff}, "byte 2"},                       // item cut short
+      {{0xb4}, "Pop without Push"},                               // pop on an empty stack
+      {{0xc0}, "End Collection without"},                         // stray end
+      {{0x05, 0x01, 0x09, 0x02, 0xa1, 0x01}, "open collection"},  // never closed
+      {{0x85, 0x00}, "Report ID 0"},
+      {{0x75, 0xff, 0x95, 0x10, 0x81, 0x02}, "Report Size"},  // 255-bit... fine size, but see next
+      {{0x76, 0x00, 0x10, 0x95, 0x01, 0x81, 0x02}, "Report Size 4096"},
+      {{0x29, 0x05}, "Usage Maximum without"},
+      {{0xfe, 0x10}, "long item"},
+  };
+  for (const auto& c : cases) {
+    auto r = parseReportDescriptor(c.bytes, "test");
+    if (std::string(c.expect) == "Report Size") {
+      EXPECT_TRUE(r) << "255-bit fields are legal";
+      continue;
+    }
+    ASSERT_FALSE(r) << c.expect;
+    EXPECT_NE(r.error().describe().find(c.expect), std::string::npos) << r.error().describe();
+    EXPECT_EQ(r.error().where(), "test");
+  }
+}
+
+TEST(HidDescriptor, FieldsGetOffsetsPerReportIdAndSignedValues) {
+  // Report 2: 8-bit signed wheel then 3 buttons; report 3: 16-bit unsigned X.
+  const std::vector<std::uint8_t> desc = {
+      0x05, 0x01, 0x09, 0x02, 0xa1, 0x01, 0x85, 0x02, 0x09, 0x38, 0x15, 0x81, 0x25, 0x7f, 0x75, 0x08, 0x95, 0x01,
+      0x81, 0x06, 0x05, 0x09, 0x19, 0x01, 0x29, 0x03, 0x15, 0x00, 0x25, 0x01, 0x75, 0x01, 0x95, 0x03, 0x81, 0x02,
+      0x85, 0x03, 0x05, 0x01, 0x09, 0x30, 0x15, 0x00, 0x26, 0xff, 0xff, 0x75, 0x10, 0x95, 0x01, 0x81, 0x02, 0xc0};
+  auto r = parseReportDescriptor(desc);
+  ASSERT_TRUE(r) << r.error().describe();
+  ASSERT_EQ(r->fields.size(), 3u);
+  EXPECT_TRUE(r->usesReportIds);
+  EXPECT_EQ(r->fields[1].bitOffset, 8u);
+  EXPECT_EQ(r->fields[1].usages[2], hid::usage(9, 3));
+  EXPECT_EQ(r->fields[2].reportId, 3);
+  EXPECT_EQ(r->fields[2].bitOffset, 0u) << "offsets restart for each report id";
+  EXPECT_EQ(r->fields[2].logicalMax, 65535) << "an unsigned maximum when the minimum is not negative";
+  const std::uint8_t data[] = {0xfe, 0x05};
+  EXPECT_EQ(hid::extractElement(r->fields[0], 0, data), -2);
+  EXPECT_EQ(hid::extractElement(r->fields[1], 0, data), 1) << "0x05: buttons 1 and 3";
+  EXPECT_EQ(hid::extractElement(r->fields[1], 1, data), 0);
+  EXPECT_EQ(hid::extractElement(r->fields[1], 2, data), 1);
+  bool ok = true;
+  (void)hid::extractElement(r->fields[1], 0, std::span(data).first(1), &ok);
+  EXPECT_FALSE(ok) << "bits past the end of a short report are not read";
+  EXPECT_EQ(r->reportBytes(hid::ReportType::kInput, 2), 2u);
+}
+
+TEST(DialProfiles, PowerMateButtonAndSignedDelta) {
+  auto d = DialDecoder::create(kGriffinVendor, kPowerMateProduct, {});
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->profile(), DialProfile::kPowerMate);
+  const std::uint8_t press[] = {0x01, 0xfd, 0, 0x50, 0, 0};
+  auto events = decodeAll(*d, press);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].kind, EventKind::kButton);
+  EXPECT_EQ(events[0].value, 1);
+  EXPECT_DOUBLE_EQ(events[1].value, -3 / kPowerMateCountsPerTurn);
+  const std::uint8_t idle[] = {0x01, 0x00};
+  EXPECT_TRUE(decodeAll(*d, idle).empty()) << "a held button and no turn: nothing new";
+  const std::uint8_t tooShort[] = {0x01};
+  EXPECT_TRUE(decodeAll(*d, tooShort).empty());
+}
+
+TEST(DialProfiles, ShuttleJogWrapsRingAndButtons) {
+  for (std::uint16_t product : {kShuttleProV1Product, kShuttleXpressProduct, kShuttleProV2Product}) {
+    auto d = DialDecoder::create(kContourVendor, product, {});
+    ASSERT_TRUE(d);
+    EXPECT_EQ(d->profile(), DialProfile::kShuttle);
+    const std::uint8_t first[] = {0x00, 0xfe, 0x00, 0x00, 0x00};
+    EXPECT_TRUE(decodeAll(*d, first).empty()) << "the first jog value is only a reference";
+    const std::uint8_t wrapped[] = {0x03, 0x01, 0x00, 0x10, 0x01};  // jog 254 -> 1 is +3; ring +3; buttons 4, 8
+    auto events = decodeAll(*d, wrapped);
+    ASSERT_EQ(events.size(), 4u);
+    EXPECT_EQ(events[0].kind, EventKind::kShuttle);
+    EXPECT_DOUBLE_EQ(events[0].value, 3.0 / 7);
+    EXPECT_EQ(events[1].kind, EventKind::kDialDelta);
+    EXPECT_DOUBLE_EQ(events[1].value, 3 / kShuttleJogCountsPerTurn);
+    EXPECT_EQ(events[2].index, 4);
+    EXPECT_EQ(events[3].index, 8);
+    const std::uint8_t back[] = {0xf9, 0xfd, 0x00, 0x00, 0x00};  // ring -7, jog 1 -> 253 = -4, buttons up
+    events = decodeAll(*d, back);
+    ASSERT_EQ(events.size(), 4u);
+    EXPECT_DOUBLE_EQ(events[0].value, -1.0);
+    EXPECT_DOUBLE_EQ(events[1].value, -4 / kShuttleJogCountsPerTurn);
+    EXPECT_EQ(events[2].value, 0);
+  }
+}
+
+TEST(DialProfiles, AbsoluteWrappingAxisGivesDeltas) {
+  // One 8-bit absolute Dial with the Wrap flag, 0..255.
+  const std::vector<std::uint8_t> desc = {0x05, 0x01, 0x09, 0x08, 0xa1, 0x01, 0x09, 0x37, 0x15, 0x00,
+                                          0x26, 0xff, 0x00, 0x75, 0x08, 0x95, 0x01, 0x81, 0x0a, 0xc0};
+  auto d = DialDecoder::create(0x1234, 0x5678, desc);
+  ASSERT_TRUE(d) << d.error().describe();
+  EXPECT_DOUBLE_EQ(d->channels()[0].countsPerTurn, 256);
+  const std::uint8_t a[] = {250}, b[] = {4};
+  EXPECT_TRUE(decodeAll(*d, a).empty());
+  auto events = decodeAll(*d, b);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_DOUBLE_EQ(events[0].value, 10.0 / 256);
+}
+
+TEST(VirtualDialBox, EncodedEventsDecodeBackExactly) {
+  VirtualReportEncoder enc;
+  auto d = DialDecoder::create(0, 0, virtualDialBoxDescriptor());
+  ASSERT_TRUE(d) << d.error().describe();
+  EXPECT_EQ(d->dialCount(), 8);
+  EXPECT_EQ(d->buttonCount(), 32);
+  std::vector<Event> decoded;
+  auto sink = [&](std::span<const std::uint8_t> report) {
+    for (const Event& e : decodeAll(*d, report)) decoded.push_back(e);
+  };
+  enc.encode(Event{Nanos{0}, 0, EventKind::kDialDelta, 3, 0.25}, sink);
+  enc.encode(Event{Nanos{0}, 0, EventKind::kButton, 31, 1}, sink);
+  enc.encode(Event{Nanos{0}, 0, EventKind::kDialDelta, 7, -20.0}, sink);  // needs several reports
+  enc.encode(Event{Nanos{0}, 0, EventKind::kButton, 31, 0}, sink);
+  ASSERT_GE(decoded.size(), 4u);
+  EXPECT_EQ(decoded[0].index, 3);
+  EXPECT_DOUBLE_EQ(decoded[0].value, 0.25);
+  EXPECT_EQ(decoded[1].kind, EventKind::kButton);
+  EXPECT_EQ(decoded[1].index, 31);
+  double turned = 0;
+  for (std::size_t i = 2; i + 1 < decoded.size(); ++i) turned += decoded[i].value;
+  EXPECT_NEAR(turned, -20.0, 1e-9);
+  EXPECT_EQ(decoded.back().value, 0);
+}
+
+TEST(HidRecordingFormat, ParsesWritesAndRejectsWithLineNumbers) {
+  const std::string text =
+      "# a comment\r\n"
+      "R: 3 05 01 c0\n"
+      "N: Test Dial\n"
+      "I: 3 077d 0410\n"
+      "E: 000001.500000 2 01 fd\n"
+      "E: 2.25 2 00 00\n";
+  auto rec = sim::parseHidRecording(text, "t.hid");
+  ASSERT_TRUE(rec) << rec.error().describe();
+  ASSERT_EQ(rec->devices.size(), 1u);
+  const auto& d = rec->devices[0];
+  EXPECT_EQ(d.name, "Test Dial");
+  EXPECT_EQ(d.vendor, 0x077d);
+  ASSERT_EQ(d.reports.size(), 2u);
+  EXPECT_EQ(d.reports[0].time, Nanos{1'500'000'000});
+  EXPECT_EQ(d.reports[1].time, Nanos{2'250'000'000});
+  EXPECT_EQ(sim::HidRecordingWriter::reportLine(Nanos{1'500'000'000}, d.reports[0].bytes),
+            "E: 000001.500000 2 01 fd\n");
+  const std::string header = sim::HidRecordingWriter::header(d, false);
+  auto again = sim::parseHidRecording(header + "E: 000001.500000 2 01 fd\n", "again");
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->devices[0].descriptor, d.descriptor);
+
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"E: 0.1 1 00\n", "t.hid:1"},
+      {"R: 2 05\n", "t.hid:1"},
+      {"R: 1 zz\n", "t.hid:1"},
+      {"R: 1 05\nE: x 1 00\n", "t.hid:2"},
+      {"R: 1 05\nQ: what\n", "t.hid:2"},
+      {"# only a comment\n", "t.hid"},
+      {"R: 1 05\nI: 3 nothex 1\n", "t.hid:2"},
+  };
+  for (const auto& [input, where] : bad) {
+    auto r = sim::parseHidRecording(input, "t.hid");
+    ASSERT_FALSE(r) << input;
+    EXPECT_EQ(r.error().where(), where) << input << " -> " << r.error().describe();
+  }
+}
+
+}  // namespace
+}  // namespace basalt::devices
