@@ -93,8 +93,8 @@ std::shared_ptr<VideoSource> makeLibcamera(const Clock& clock, std::string& reas
   auto cameras = provider.enumerate();
   if (cameras.empty()) {
     reason =
-        "libcamera sees no camera here (it needs a CSI sensor or a UVC camera; the virtual lab's UVC gadget "
-        "is tested through v4l2)";
+        "libcamera sees no camera here (it needs a CSI sensor or a UVC camera that udev has processed; the "
+        "virtual lab has one: make vlab)";
     return nullptr;
   }
   DeviceRequest r;
@@ -241,7 +241,7 @@ INSTANTIATE_TEST_SUITE_P(Backends, VideoSourceContract,
                                                         true},
                                            VideoBackend{"v4l2_uvc",
                                                         [](const Clock& c, std::string& r) {
-                                                          return makeV4l2("BASALT_VLAB_V4L2_UVC", "a UVC gadget", c, r);
+                                                          return makeV4l2("BASALT_VLAB_V4L2_UVC", "the lab's UVC camera", c, r);
                                                         },
                                                         true},
                                            VideoBackend{"libcamera", makeLibcamera, true}),
