@@ -455,7 +455,9 @@ void V4l2Camera::stopStreaming(bool waitForShow) {
   if (!buffers_) return;
   buffers_->setStreaming(false);
   int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  xioctl(fd_.get(), VIDIOC_STREAMOFF, &type);
+  if (xioctl(fd_.get(), VIDIOC_STREAMOFF, &type) != 0) {
+    log::warn(kLogV4l2, "{}: cannot stop streaming: {}", path_, std::strerror(errno));
+  }
   if (waitForShow && !buffers_->waitForFrames(std::chrono::milliseconds(1000))) {
     log::warn(kLogV4l2, "{}: the show still holds {} frame(s) after 1 s", path_, buffers_->outstanding());
   }
@@ -465,7 +467,10 @@ void V4l2Camera::stopStreaming(bool waitForShow) {
   req.count = 0;
   req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   req.memory = V4L2_MEMORY_MMAP;
-  xioctl(fd_.get(), VIDIOC_REQBUFS, &req);  // EBUSY while frames are still mapped; harmless at close
+  if (xioctl(fd_.get(), VIDIOC_REQBUFS, &req) != 0) {
+    // The driver keeps the buffers, and refuses a new format or new timings while it does.
+    log::debug(kLogV4l2, "{}: cannot free the capture buffers: {}", path_, std::strerror(errno));
+  }
 }
 
 bool V4l2Camera::dequeue() {

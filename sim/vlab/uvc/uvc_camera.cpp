@@ -576,6 +576,9 @@ void UvcCamera::startStreaming(Nanos now) {
   writer_.abort();
   writer_.setMaxPayload(commit_.maxPayloadTransferSize);
   streamStart_ = now;
+  // The counter runs over the camera's life: a stream started again (uvcvideo commits at
+  // VIDIOC_S_FMT and again at STREAMON) never goes back behind a frame already sent.
+  counterBase_ = framesSent_ > 0 ? lastCounter_ + 1 : 0;
   nextFrameDue_ = now;
   lastFrameIndex_ = -1;
   fid_ = false;
@@ -610,7 +613,7 @@ void UvcCamera::produceFrame(Nanos now) {
   if (index <= lastFrameIndex_) index = lastFrameIndex_ + 1;
   const Nanos captured = streamStart_ + index * frameInterval_;
   nextFrameDue_ = captured + frameInterval_;
-  const auto counter = static_cast<std::uint32_t>(index);
+  const auto counter = counterBase_ + static_cast<std::uint32_t>(index);
   if (pixelFormat_ == UvcPixelFormat::kYuyv) {
     frame_.resize(std::size_t{picture_->width()} * picture_->height() * 2);
     picture_->renderYuyv(counter, brightness_, planes_, frame_);

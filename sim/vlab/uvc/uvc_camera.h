@@ -221,6 +221,7 @@ class UvcCamera final : public UsbDevice {
   Nanos nextFrameDue_{0};
   std::int64_t lastFrameIndex_ = -1;
   std::uint32_t lastCounter_ = 0;
+  std::uint32_t counterBase_ = 0;  ///< the first counter of the current stream
   std::uint64_t framesSent_ = 0;
   std::uint64_t oversizedFrames_ = 0;
   const TestPicture* picture_ = nullptr;
