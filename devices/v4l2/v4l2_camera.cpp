@@ -320,6 +320,16 @@ Result<void> V4l2Camera::negotiate(bool* noSignal) {
       return std::unexpected(sysError(path_, "cannot query the DV timings", errno));
     }
     if (xioctl(fd_.get(), VIDIOC_S_DV_TIMINGS, &t) != 0) {
+      if (errno == EINVAL || errno == ERANGE) {
+        // The source sends timings this receiver cannot take (a pixel clock out of its range,
+        // say): no usable signal until the source changes again.
+        return fail(Errc::kUnsupported,
+                    fmt::format("the HDMI source sends {}x{}{} at {:.2f} MHz, which this receiver cannot capture; "
+                                "set the source to another mode",
+                                std::uint32_t{t.bt.width}, std::uint32_t{t.bt.height}, t.bt.interlaced ? "i" : "p",
+                                static_cast<double>(std::uint64_t{t.bt.pixelclock}) / 1e6),
+                    path_);
+      }
       return std::unexpected(sysError(path_, "cannot set the DV timings", errno));
     }
     width = t.bt.width;
@@ -445,7 +455,9 @@ void V4l2Camera::stopStreaming(bool waitForShow) {
   if (!buffers_) return;
   buffers_->setStreaming(false);
   int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  xioctl(fd_.get(), VIDIOC_STREAMOFF, &type);
+  if (xioctl(fd_.get(), VIDIOC_STREAMOFF, &type) != 0) {
+    log::warn(kLogV4l2, "{}: cannot stop streaming: {}", path_, std::strerror(errno));
+  }
   if (waitForShow && !buffers_->waitForFrames(std::chrono::milliseconds(1000))) {
     log::warn(kLogV4l2, "{}: the show still holds {} frame(s) after 1 s", path_, buffers_->outstanding());
   }
@@ -455,7 +467,10 @@ void V4l2Camera::stopStreaming(bool waitForShow) {
   req.count = 0;
   req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   req.memory = V4L2_MEMORY_MMAP;
-  xioctl(fd_.get(), VIDIOC_REQBUFS, &req);  // EBUSY while frames are still mapped; harmless at close
+  if (xioctl(fd_.get(), VIDIOC_REQBUFS, &req) != 0) {
+    // The driver keeps the buffers, and refuses a new format or new timings while it does.
+    log::debug(kLogV4l2, "{}: cannot free the capture buffers: {}", path_, std::strerror(errno));
+  }
 }
 
 bool V4l2Camera::dequeue() {
@@ -527,9 +542,17 @@ void V4l2Camera::handleEvents() {
   reportLost(Error(Errc::kUnavailable, "the HDMI source changed; renegotiating", path_), true);
   std::lock_guard lock(controlMutex_);
   stopStreaming(true);
+  // A mode that cannot be captured is not the end of the input: the source may change again (the
+  // next source-change event renegotiates), unless the device itself went away.
+  auto cannotCapture = [this](const Error& e) {
+    log::warn(kLogV4l2, "{}: the HDMI source changed and cannot be captured: {}; waiting for it to change again", path_,
+              e.describe());
+    stopStreaming(false);
+    reportLost(e, e.code() != Errc::kDeviceLost);
+  };
   bool noSignal = false;
   if (auto r = negotiate(&noSignal); !r) {
-    reportLost(r.error());
+    cannotCapture(r.error());
     return;
   }
   if (noSignal) {
@@ -537,7 +560,7 @@ void V4l2Camera::handleEvents() {
     return;
   }
   if (auto r = startStreaming(); !r) {
-    reportLost(r.error());
+    cannotCapture(r.error());
     return;
   }
   log::info(kLogV4l2, "{}: signal back as {}", path_, describeMode(mode_));

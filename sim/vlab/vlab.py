@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Basalt's virtual lab: a stock Debian kernel under qemu with real drivers (vivid, dummy_hcd
-with configfs HID and UVC gadgets, uhid, virtio-gpu), the host's root mounted read-only, running
-Basalt's test binaries against it.
+with configfs HID gadgets, uhid, virtio-gpu, uvcvideo with the lab's own UVC camera plugged in
+through qemu's usb-redir), the host's root mounted read-only, running Basalt's test binaries
+against it.
 
     vlab.py build [--force]            build (or find cached) the kernel and initramfs
     vlab.py run [opts] -- PROG ARGS    run one program inside the lab; its output and exit status
@@ -192,6 +193,7 @@ def build(force=False):
         deb = kernel_deb(cache)
         lab = os.path.join(cache, "lab-" + lab_key(deb))
         if os.path.isfile(os.path.join(lab, "lab.json")) and not force:
+            os.utime(os.path.join(lab, "lab.json"))  # in use: kept by prune_labs
             return lab
         if free_mb(cache) < NEEDED_MB:
             raise LabUnavailable(f"no free disk: building the lab needs about {NEEDED_MB} MB in {cache}, "
@@ -223,12 +225,23 @@ def build(force=False):
             if os.path.isdir(lab):
                 shutil.rmtree(lab)
             os.replace(out, lab)
-        # Labs of older inputs are not used again (a running qemu has its kernel in memory).
-        for old in glob.glob(os.path.join(cache, "lab-*")):
-            if old != lab:
-                shutil.rmtree(old, ignore_errors=True)
+        prune_labs(cache, lab)
         say(f"lab built in {time.monotonic() - started:.1f} s: {lab}")
         return lab
+
+
+def prune_labs(cache, keep, unused_days=3):
+    """Removes labs not used for `unused_days` (12 MB each). Labs of other inputs stay for a
+    while: checkouts of different branches share the cache, and deleting the lab another one
+    is about to boot would make each rebuild the other's."""
+    for old in glob.glob(os.path.join(cache, "lab-*")):
+        stamp = os.path.join(old, "lab.json")
+        try:
+            idle = time.time() - os.path.getmtime(stamp)
+        except OSError:
+            idle = float("inf")  # a half-built lab left by a killed build
+        if old != keep and idle > unused_days * 86400:
+            shutil.rmtree(old, ignore_errors=True)
 
 
 def closure(tree, version, root):
@@ -298,6 +311,56 @@ def tools_dir(build_dir):
     return ""
 
 
+class HostCamera:
+    """The lab's webcam: basalt-vlab-uvc-camera runs here, on the host, and qemu's usb-redir
+    device plugs it into the guest's emulated xHCI (qemu-xhci), where uvcvideo binds it. The
+    guest unplugs and replugs it by writing "unplug" or "plug" to RESULTS/uvc-camera.request
+    (gadget-ctl does); the camera says its state in uvc-camera.request.state."""
+
+    def __init__(self, build_dir):
+        self.program = os.path.join(build_dir, "sim", "vlab", "basalt-vlab-uvc-camera") if build_dir else None
+        self.missing = None
+        if not self.program or not os.access(self.program, os.X_OK):
+            self.missing = (f"the camera program {self.program} is not built (cmake --build the tree)" if self.program
+                            else "no build tree, so no camera program (basalt-vlab-uvc-camera)")
+            self.program = None
+        # A short folder of its own for the socket (a UNIX socket path has at most 107 bytes).
+        self.folder = tempfile.mkdtemp(prefix="basalt-vlab-")
+        self.socket = os.path.join(self.folder, "uvc.sock")
+        self.proc = None
+
+    def conf(self):
+        if self.program:
+            return "BASALT_VLAB_UVC_CAMERA=usbredir\n"
+        return f"BASALT_VLAB_UVC_CAMERA=\nBASALT_VLAB_UVC_CAMERA_MISSING={shlex.quote(self.missing)}\n"
+
+    def qemu_args(self):
+        if not self.program:
+            return []
+        return ["-chardev", f"socket,id=uvccam,path={self.socket},server=on,wait=off",
+                "-device", "usb-redir,chardev=uvccam,id=uvccam,bus=xhci.0"]
+
+    def start(self, results):
+        """Starts the camera once qemu runs (it waits for qemu's socket)."""
+        if not self.program:
+            return
+        with open(os.path.join(results, "uvc-camera.log"), "w", encoding="utf-8") as log:
+            self.proc = subprocess.Popen([self.program, "--usbredir", self.socket, "--connect-timeout", "60",
+                                          "--control", os.path.join(results, "uvc-camera.request")],
+                                         stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
+                                         start_new_session=True)
+
+    def stop(self):
+        if self.proc and self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+
 def check_path(path, what):
     if re.search(r"[\s,:'\"\\]", path):
         raise LabUnavailable(f"{what} {path!r} has a space, comma, colon or quote; the lab cannot share it")
@@ -313,14 +376,16 @@ def console_tail(path, lines=40):
     return "\n".join(text.splitlines()[-lines:]) or "(the console log is empty)"
 
 
-def qemu_argv(lab, results, shares, mode):
+def qemu_argv(lab, results, shares, mode, camera=None):
     cmdline = ["console=ttyS0", "quiet", "loglevel=4", "panic=-1", "oops=panic", f"basalt.mode={mode}",
                f"basalt.lab={os.path.join(HERE, 'guest', 'lab.sh')}", f"basalt.results={results}"]
     argv = [qemu_binary(), "-accel", "tcg", "-m", os.environ.get("BASALT_VLAB_MEMORY", "1024"), "-smp", "2",
             "-nodefaults", "-no-user-config", "-no-reboot", "-display", "none",
             "-kernel", os.path.join(lab, "vmlinuz"), "-initrd", os.path.join(lab, "initrd.gz"),
-            "-vga", "none", "-device", "virtio-gpu-pci",
+            "-vga", "none", "-device", "virtio-gpu-pci", "-device", "qemu-xhci,id=xhci",
             "-virtfs", "local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap"]
+    if camera:
+        argv += camera.qemu_args()
     rw = []
     for i, path in enumerate(shares):
         argv += ["-virtfs", f"local,path={path},mount_tag=rw{i},security_model=none,multidevs=remap"]
@@ -336,7 +401,7 @@ def qemu_argv(lab, results, shares, mode):
 
 
 def prepare(results, build_dir):
-    """Makes the results folder and decides the writable shares."""
+    """Makes the results folder, decides the writable shares and the host-side camera."""
     results = os.path.abspath(results)
     os.makedirs(results, exist_ok=True)
     for name in os.listdir(results):
@@ -353,9 +418,10 @@ def prepare(results, build_dir):
         shares.append(results)
     for p in shares + [results, HERE]:
         check_path(p, "the path")
+    camera = HostCamera(build_dir)
     with open(os.path.join(results, "lab.conf"), "w", encoding="utf-8") as f:
-        f.write(f"BASALT_VLAB_SRC={SOURCE}\nBASALT_VLAB_TOOLS={tools_dir(build_dir)}\n")
-    return results, shares
+        f.write(f"BASALT_VLAB_SRC={SOURCE}\nBASALT_VLAB_TOOLS={tools_dir(build_dir)}\n" + camera.conf())
+    return results, shares, camera
 
 
 def write_jobs(results, jobs):
@@ -373,17 +439,22 @@ def write_jobs(results, jobs):
                 s.write("\n".join(lines) + "\n")
 
 
-def boot(results, shares, jobs, boot_timeout):
+def boot(results, shares, jobs, boot_timeout, camera):
     """Boots the lab, runs the jobs, waits for power-off. Raises LabFailed with the console tail."""
-    lab = build()
+    try:
+        lab = build()
+    except (LabUnavailable, LabFailed):
+        camera.stop()
+        raise
     budget = boot_timeout + sum(int(j.get("timeout", 300)) + 10 for j in jobs) + 30
-    argv = qemu_argv(lab, results, shares, "run")
+    argv = qemu_argv(lab, results, shares, "run", camera)
     console = os.path.join(results, "console.log")
     started = time.monotonic()
     with open(os.path.join(results, "qemu.log"), "w", encoding="utf-8") as qlog:
         proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=qlog, stderr=subprocess.STDOUT,
                                 start_new_session=True)
     try:
+        camera.start(results)
         booted = False
         while proc.poll() is None:
             elapsed = time.monotonic() - started
@@ -410,6 +481,7 @@ def boot(results, shares, jobs, boot_timeout):
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
+        camera.stop()
 
 
 def read(path):
@@ -457,9 +529,9 @@ def cmd_run(args):
     if not os.path.isabs(prog) and os.path.exists(prog):
         prog = os.path.abspath(prog)
     job = {"name": "run", "argv": [prog] + args.argv[1:], "timeout": args.timeout, "cwd": os.getcwd()}
-    results, shares = prepare(results, build_dir)
+    results, shares, camera = prepare(results, build_dir)
     write_jobs(results, [job])
-    boot(results, shares, [job], args.boot_timeout)
+    boot(results, shares, [job], args.boot_timeout, camera)
     print_fixtures(results)
     sys.stdout.write(read(os.path.join(results, "run.log")))
     sys.stdout.flush()
@@ -475,13 +547,17 @@ def cmd_batch(args):
     with open(args.jobs, encoding="utf-8") as f:
         jobs = json.load(f)["jobs"]
     build_dir = args.build or default_build_dir()
-    results, shares = prepare(args.results, build_dir)
+    results, shares, camera = prepare(args.results, build_dir)
     for job in jobs:
         job.setdefault("env", {})
         if job.get("gtest"):
             job["env"]["GTEST_OUTPUT"] = f"xml:{os.path.join(results, job['name'] + '.xml')}"
-    write_jobs(results, jobs)
-    boot(results, shares, jobs, args.boot_timeout)
+    try:
+        write_jobs(results, jobs)
+    except LabFailed:
+        camera.stop()
+        raise
+    boot(results, shares, jobs, args.boot_timeout, camera)
     print_fixtures(results)
     worst = 0
     for job in jobs:
@@ -603,10 +679,18 @@ def cmd_shell(args):
     lab = build()
     build_dir = args.build or default_build_dir()
     results = os.path.join(build_dir or cache_dir(), "vlab", "runs", "shell")
-    results, shares = prepare(results, build_dir)
-    argv = qemu_argv(lab, results, shares, "shell")
+    results, shares, camera = prepare(results, build_dir)
+    argv = qemu_argv(lab, results, shares, "shell", camera)
     say("starting the lab shell (Ctrl-A X quits qemu)")
-    return subprocess.call(argv)
+    proc = subprocess.Popen(argv)
+    try:
+        camera.start(results)
+        return proc.wait()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        camera.stop()
 
 
 def cmd_check(_args):

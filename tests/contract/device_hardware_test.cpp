@@ -68,7 +68,8 @@ TEST(V4l2Hardware, HdmiSignalLossAndResolutionChangeRenegotiate) {
         serviceAndDrain,
         [&] { return source->mode().width != before.width && source->health().state == SourceState::kLive; }, 5s);
   }
-  EXPECT_TRUE(changed) << "no resolution change was renegotiated";
+  EXPECT_TRUE(changed) << "no resolution change was renegotiated; lost: "
+                       << (source->lostReason() ? source->lostReason()->describe() : "no");
   source->close();
 }
 

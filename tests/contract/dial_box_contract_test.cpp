@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <functional>
@@ -171,13 +172,16 @@ Made makeHidGadget(const Clock& clock, std::string& reason) {
       return {};
     }
     const std::vector<std::uint8_t> report = test::makeDialReport((*box)->reportDescriptor(), 3);
-    auto out = std::make_shared<UniqueFd>(::open(gadget->c_str(), O_WRONLY | O_CLOEXEC));
+    // Non-blocking: once the host side is closed, usbhid stops polling the interrupt endpoint and
+    // a blocking write to the gadget would wait for it forever (and the feeder could not stop).
+    auto out = std::make_shared<UniqueFd>(::open(gadget->c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC));
     if (report.empty() || !*out) {
       reason = "cannot write dial reports to " + *gadget;
       return {};
     }
     auto feeder = std::make_unique<ThreadFeeder>([out, report] {
-      return ::write(out->get(), report.data(), report.size()) == static_cast<ssize_t>(report.size());
+      return ::write(out->get(), report.data(), report.size()) == static_cast<ssize_t>(report.size()) ||
+             errno == EAGAIN;  // the host has not read the previous report yet
     });
     return {std::move(feeder), std::move(*box)};
   }
@@ -201,7 +205,7 @@ Made makeUhid(const Clock& clock, std::string& reason) {
   create.type = UHID_CREATE2;
   std::snprintf(reinterpret_cast<char*>(create.u.create2.name), sizeof create.u.create2.name, "Basalt uhid dial");
   create.u.create2.rd_size = static_cast<std::uint16_t>(desc.size());
-  create.u.create2.bus = 0x06;
+  create.u.create2.bus = 0x05;  // BUS_BLUETOOTH: hidapi lists only USB, Bluetooth, I2C and SPI devices
   create.u.create2.vendor = 0x1d6b;
   create.u.create2.product = 0xba5a;
   std::memcpy(create.u.create2.rd_data, desc.data(), desc.size());
@@ -246,14 +250,15 @@ Made makePowerMateGadget(const Clock& clock, std::string& reason) {
     reason = box.error().describe();
     return {};
   }
-  auto out = std::make_shared<UniqueFd>(::open(gadget->c_str(), O_WRONLY | O_CLOEXEC));
+  // Non-blocking, as for the dial gadget: nobody polls the endpoint while the device is closed.
+  auto out = std::make_shared<UniqueFd>(::open(gadget->c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC));
   if (!*out) {
     reason = "cannot open " + *gadget;
     return {};
   }
   auto feeder = std::make_unique<ThreadFeeder>([out] {
     const std::uint8_t report[6] = {0, 2, 0, 0, 0, 0};
-    return ::write(out->get(), report, sizeof report) == 6;
+    return ::write(out->get(), report, sizeof report) == 6 || errno == EAGAIN;
   });
   return {std::move(feeder), std::move(*box)};
 }

@@ -93,8 +93,8 @@ std::shared_ptr<VideoSource> makeLibcamera(const Clock& clock, std::string& reas
   auto cameras = provider.enumerate();
   if (cameras.empty()) {
     reason =
-        "libcamera sees no camera here (it needs a CSI sensor or a UVC camera; the virtual lab's UVC gadget "
-        "is tested through v4l2)";
+        "libcamera sees no camera here (it needs a CSI sensor or a UVC camera that udev has processed; the "
+        "virtual lab has one: make vlab)";
     return nullptr;
   }
   DeviceRequest r;
@@ -225,27 +225,26 @@ TEST_P(VideoSourceContract, MirrorIsAppliedByTheDeviceOrTheRenderer) {
   EXPECT_FALSE(source_->setControls(c)) << "quality is 0..100";
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, VideoSourceContract,
-                         ::testing::Values(VideoBackend{"synthetic", makeSynthetic}, VideoBackend{"replay", makeReplay},
-                                           VideoBackend{"v4l2_webcam",
-                                                        [](const Clock& c, std::string& r) {
-                                                          return makeV4l2("BASALT_VLAB_V4L2_WEBCAM",
-                                                                          "vivid's webcam input", c, r);
-                                                        },
-                                                        true},
-                                           VideoBackend{"v4l2_hdmi",
-                                                        [](const Clock& c, std::string& r) {
-                                                          return makeV4l2("BASALT_VLAB_V4L2_HDMI", "a vivid HDMI input",
-                                                                          c, r);
-                                                        },
-                                                        true},
-                                           VideoBackend{"v4l2_uvc",
-                                                        [](const Clock& c, std::string& r) {
-                                                          return makeV4l2("BASALT_VLAB_V4L2_UVC", "a UVC gadget", c, r);
-                                                        },
-                                                        true},
-                                           VideoBackend{"libcamera", makeLibcamera, true}),
-                         [](const ::testing::TestParamInfo<VideoBackend>& param) { return param.param.name; });
+INSTANTIATE_TEST_SUITE_P(
+    Backends, VideoSourceContract,
+    ::testing::Values(VideoBackend{"synthetic", makeSynthetic}, VideoBackend{"replay", makeReplay},
+                      VideoBackend{"v4l2_webcam",
+                                   [](const Clock& c, std::string& r) {
+                                     return makeV4l2("BASALT_VLAB_V4L2_WEBCAM", "vivid's webcam input", c, r);
+                                   },
+                                   true},
+                      VideoBackend{"v4l2_hdmi",
+                                   [](const Clock& c, std::string& r) {
+                                     return makeV4l2("BASALT_VLAB_V4L2_HDMI", "a vivid HDMI input", c, r);
+                                   },
+                                   true},
+                      VideoBackend{"v4l2_uvc",
+                                   [](const Clock& c, std::string& r) {
+                                     return makeV4l2("BASALT_VLAB_V4L2_UVC", "the lab's UVC camera", c, r);
+                                   },
+                                   true},
+                      VideoBackend{"libcamera", makeLibcamera, true}),
+    [](const ::testing::TestParamInfo<VideoBackend>& param) { return param.param.name; });
 
 }  // namespace
 }  // namespace basalt::devices

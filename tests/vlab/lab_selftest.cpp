@@ -4,7 +4,8 @@
 // Basalt, not because of the lab. Outside the lab each test skips, saying so.
 //
 // External tools they use are Debian's (scripts/packages.txt): v4l2-ctl (v4l-utils) for V4L2,
-// kmscube for KMS, so that the lab is checked by programs other than Basalt's own backends.
+// kmscube for KMS, cam (libcamera-tools) for libcamera, so that the lab is checked by programs
+// other than Basalt's own backends.
 
 #include <fcntl.h>
 #include <poll.h>
@@ -12,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -27,6 +29,9 @@
 #include "runtime/unique_fd.h"
 #include "sim/vlab/hid_recording.h"
 #include "sim/vlab/uhid_device.h"
+#include "sim/vlab/uvc/jpeg_encoder.h"
+#include "sim/vlab/uvc/test_picture.h"
+#include "sim/vlab/uvc/uvc_camera.h"
 #include "support/process.h"
 #include "support/test_paths.h"
 
@@ -145,8 +150,8 @@ const std::vector<std::uint8_t> kDialDescriptor = {
 TEST(LabEnvironment, EveryContractVariableIsSetAndWellFormed) {
   NEED_LAB();
   EXPECT_EQ(env("BASALT_VLAB"), "1");
-  for (const char* node : {"BASALT_VLAB_V4L2_WEBCAM", "BASALT_VLAB_V4L2_HDMI", "BASALT_VLAB_HID_DIAL_GADGET",
-                           "BASALT_VLAB_HID_POWERMATE_GADGET", "BASALT_VLAB_DRM"}) {
+  for (const char* node : {"BASALT_VLAB_V4L2_WEBCAM", "BASALT_VLAB_V4L2_HDMI", "BASALT_VLAB_V4L2_UVC",
+                           "BASALT_VLAB_HID_DIAL_GADGET", "BASALT_VLAB_HID_POWERMATE_GADGET", "BASALT_VLAB_DRM"}) {
     struct stat st{};
     EXPECT_EQ(::stat(env(node).c_str(), &st), 0) << node << "=" << env(node);
     EXPECT_TRUE(S_ISCHR(st.st_mode)) << node << "=" << env(node) << " is not a character device";
@@ -156,6 +161,9 @@ TEST(LabEnvironment, EveryContractVariableIsSetAndWellFormed) {
   EXPECT_EQ(env("BASALT_VLAB_UHID"), "1");
   EXPECT_EQ(::access(env("BASALT_VLAB_GADGET_CTL").c_str(), X_OK), 0) << env("BASALT_VLAB_GADGET_CTL");
   EXPECT_NE(env("BASALT_VLAB_DRM").find("/dev/dri/card"), std::string::npos);
+  EXPECT_EQ(env("BASALT_VLAB_UDEV"), "1") << fixtureLine("udev");
+  EXPECT_TRUE(fs::is_directory(env("BASALT_VLAB_VHCI"))) << fixtureLine("vhci");
+  EXPECT_FALSE(env("BASALT_VLAB_UVC_CONTROL").empty()) << fixtureLine("uvc");
 }
 
 // Makes sure vivid's webcam input is a webcam and streams frames through mmap. Example failure:
@@ -305,14 +313,260 @@ TEST(LabDrm, VirtioGpuModesetsAndFlips) {
   EXPECT_EQ(run.output.find("user interrupted"), std::string::npos) << run.output;
 }
 
-// Makes sure the UVC camera streams through uvcvideo. Example failure: the frame pump is not
-// running, so the node exists but every capture times out.
-TEST(LabUvc, UvcCameraStreams) {
-  NEED_LAB();
+// ---- the UVC camera -------------------------------------------------------------------------
+
+std::vector<std::uint8_t> readBytes(const fs::path& p) {
+  const std::string s = readText(p);
+  return {s.begin(), s.end()};
+}
+
+/// The sysfs folder of a /dev/videoN.
+fs::path videoSysfs(const std::string& dev) { return fs::path("/sys/class/video4linux") / fs::path(dev).filename(); }
+
+/// Captures `count` frames of `format` at width x height from `dev` into a file with v4l2-ctl.
+test::ProcessResult capture(const std::string& dev, int width, int height, const std::string& format, int count,
+                            const fs::path& out) {
+  return test::run({"/usr/bin/v4l2-ctl", "-d", dev,
+                    "--set-fmt-video=width=" + std::to_string(width) + ",height=" + std::to_string(height) +
+                        ",pixelformat=" + format,
+                    "--stream-mmap", "--stream-count=" + std::to_string(count), "--stream-to=" + out.string()},
+                   {}, 120s);
+}
+
+/// The JPEG files of an MJPEG capture, which v4l2-ctl writes back to back. Each of the camera's
+/// frames starts with SOI and an APP0 segment; entropy-coded data never holds FF D8 FF.
+std::vector<std::span<const std::uint8_t>> splitJpegs(const std::vector<std::uint8_t>& data) {
+  std::vector<std::size_t> starts;
+  for (std::size_t i = 0; i + 3 < data.size(); ++i) {
+    if (data[i] == 0xff && data[i + 1] == 0xd8 && data[i + 2] == 0xff) starts.push_back(i);
+  }
+  std::vector<std::span<const std::uint8_t>> frames;
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    const std::size_t end = k + 1 < starts.size() ? starts[k + 1] : data.size();
+    frames.push_back(std::span<const std::uint8_t>(data).subspan(starts[k], end - starts[k]));
+  }
+  return frames;
+}
+
+std::string uvcNode() {
   const std::string dev = env("BASALT_VLAB_V4L2_UVC");
-  if (dev.empty()) GTEST_SKIP() << "the lab has no UVC camera: " << fixtureLine("uvc");
-  const auto stream = test::run({"/usr/bin/v4l2-ctl", "-d", dev, "--stream-mmap", "--stream-count=2"}, {}, 60s);
+  return dev;
+}
+
+// Makes sure the lab's camera is a webcam bound by uvcvideo, behind the guest's PCI USB
+// controller (qemu-xhci), offering the lab camera's formats, sizes and frame rates. Example
+// failure: the descriptors' frame intervals are in the wrong unit, and uvcvideo lists 3000 fps.
+TEST(LabUvc, CameraIsAUvcvideoWebcamWithItsFormats) {
+  NEED_LAB();
+  const std::string dev = uvcNode();
+  ASSERT_FALSE(dev.empty()) << fixtureLine("uvc");
+  const auto info = test::run({"/usr/bin/v4l2-ctl", "-d", dev, "--info", "--list-formats-ext"});
+  ASSERT_EQ(info.exitCode, 0) << info.output;
+  EXPECT_NE(info.output.find("uvcvideo"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("Basalt Lab Camera"), std::string::npos) << info.output;
+  for (const char* want :
+       {"'YUYV'", "'MJPG'", "640x480", "320x240", "1280x720", "(30.000 fps)", "(15.000 fps)", "(5.000 fps)"}) {
+    EXPECT_NE(info.output.find(want), std::string::npos) << "no " << want << " in\n" << info.output;
+  }
+  const fs::path usb = fs::canonical(videoSysfs(dev) / "device").parent_path();
+  EXPECT_EQ(trimmed(readText(usb / "idVendor")) + ":" + trimmed(readText(usb / "idProduct")), "1209:0002");
+  EXPECT_NE(usb.string().find("/pci"), std::string::npos) << "not behind a PCI controller: " << usb;
+  EXPECT_EQ(trimmed(readText(usb / "speed")), "480") << "a high-speed device";
+}
+
+// Makes sure YUYV frames stream through uvcvideo with the negotiated size and format, whole,
+// and with the camera's frame counter rising from frame to frame. Example failure: uvcvideo
+// drops every frame as incomplete because a payload header is wrong, and the capture hangs.
+TEST(LabUvc, StreamsYuyvWithAChangingFrameCounter) {
+  NEED_LAB();
+  const std::string dev = uvcNode();
+  ASSERT_FALSE(dev.empty()) << fixtureLine("uvc");
+  const fs::path out = "/tmp/vlab-uvc.yuyv";
+  const auto stream = capture(dev, 320, 240, "YUYV", 6, out);
+  ASSERT_EQ(stream.exitCode, 0) << stream.output;
+  const auto fmt = test::run({"/usr/bin/v4l2-ctl", "-d", dev, "--get-fmt-video"});
+  EXPECT_NE(fmt.output.find("320/240"), std::string::npos) << fmt.output;
+  EXPECT_NE(fmt.output.find("'YUYV'"), std::string::npos) << fmt.output;
+  const auto data = readBytes(out);
+  constexpr std::size_t kFrame = std::size_t{320} * 240 * 2;
+  ASSERT_EQ(data.size(), 6 * kFrame) << "six whole 320x240 YUYV frames";
+  std::optional<std::uint32_t> last;
+  for (std::size_t i = 0; i < 6; ++i) {
+    const auto counter =
+        sim::vlab::readFrameCounterYuyv(std::span<const std::uint8_t>(data).subspan(i * kFrame, kFrame), 320, 240);
+    ASSERT_TRUE(counter) << "frame " << i << " has no readable counter";
+    if (last) {
+      EXPECT_GT(*counter, *last) << "frame " << i;
+    }
+    last = counter;
+  }
+}
+
+// Makes sure MJPEG frames stream through uvcvideo as whole JPEG files of the negotiated size,
+// with rising frame numbers. The lab reads the number the camera writes into each frame's COM
+// segment: decoding JPEG under TCG costs minutes, and the unit tests (uvc_camera_test.cpp) check
+// with libjpeg that the picture carries the same counter. Example failure: the last payload of a
+// frame lacks the end-of-frame bit, so uvcvideo glues two JPEG files into one buffer.
+TEST(LabUvc, StreamsMjpegFramesThatAreWholeJpegs) {
+  NEED_LAB();
+  const std::string dev = uvcNode();
+  ASSERT_FALSE(dev.empty()) << fixtureLine("uvc");
+  const fs::path out = "/tmp/vlab-uvc.mjpg";
+  const auto stream = capture(dev, 640, 480, "MJPG", 4, out);
+  ASSERT_EQ(stream.exitCode, 0) << stream.output;
+  const auto data = readBytes(out);
+  const auto frames = splitJpegs(data);
+  ASSERT_EQ(frames.size(), 4U) << data.size() << " bytes";
+  std::optional<std::uint32_t> last;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const auto info = sim::vlab::inspectJpeg(frames[i]);
+    ASSERT_TRUE(info) << "frame " << i << " is not a JPEG file";
+    EXPECT_TRUE(info->complete) << "frame " << i << " does not end with EOI";
+    EXPECT_EQ(info->width, 640U);
+    EXPECT_EQ(info->height, 480U);
+    const auto number = sim::vlab::mjpegFrameNumber(frames[i]);
+    ASSERT_TRUE(number) << "frame " << i << " comment: " << info->comment;
+    if (last) {
+      EXPECT_GT(*number, *last) << "frame " << i;
+    }
+    last = number;
+  }
+}
+
+// Makes sure a V4L2 control reaches the camera through uvcvideo's UVC requests and changes the
+// picture. Example failure: the processing unit's descriptor is too short, uvcvideo drops the
+// control, and brightness is not offered.
+TEST(LabUvc, BrightnessControlReachesTheCamera) {
+  NEED_LAB();
+  const std::string dev = uvcNode();
+  ASSERT_FALSE(dev.empty()) << fixtureLine("uvc");
+  struct Restore {
+    std::string dev;
+    ~Restore() { test::run({"/usr/bin/v4l2-ctl", "-d", dev, "--set-ctrl=brightness=128"}); }
+  } restore{dev};
+  const auto set = test::run({"/usr/bin/v4l2-ctl", "-d", dev, "--set-ctrl=brightness=230"});
+  ASSERT_EQ(set.exitCode, 0) << set.output;
+  const auto get = test::run({"/usr/bin/v4l2-ctl", "-d", dev, "--get-ctrl=brightness"});
+  EXPECT_EQ(trimmed(get.output), "brightness: 230");
+  const fs::path out = "/tmp/vlab-uvc-bright.yuyv";
+  const auto stream = capture(dev, 320, 240, "YUYV", 1, out);
+  ASSERT_EQ(stream.exitCode, 0) << stream.output;
+  const auto data = readBytes(out);
+  ASSERT_EQ(data.size(), 320U * 240 * 2);
+  // The last row is black (luma 16) at the default brightness; 230 lifts luma by (230 - 128) / 2.
+  double sum = 0;
+  for (std::size_t x = 0; x < 320; ++x) sum += data[(std::size_t{239} * 320 + x) * 2];
+  EXPECT_NEAR(sum / 320, 16 + 51, 3);
+  EXPECT_TRUE(sim::vlab::readFrameCounterYuyv(data, 320, 240)) << "the counter survives brightness";
+}
+
+// Makes sure gadget-ctl pulls the camera's cable and puts it back: the node goes, comes back
+// under the same name, and streams again. Example failure: the camera program misses the
+// request written from the guest (9p), and `unplug` times out.
+TEST(LabHotplug, UvcCameraUnplugsAndReplugs) {
+  NEED_LAB();
+  const std::string dev = uvcNode();
+  ASSERT_FALSE(dev.empty()) << fixtureLine("uvc");
+  const auto unplug = gadgetCtl("unplug", "uvc");
+  ASSERT_EQ(unplug.exitCode, 0) << unplug.output;
+  EXPECT_FALSE(fs::exists(dev)) << dev << " is still there";
+  const auto again = gadgetCtl("unplug", "uvc");
+  EXPECT_EQ(again.exitCode, 1) << again.output;
+  EXPECT_NE(again.output.find("already unplugged"), std::string::npos) << again.output;
+  const auto plug = gadgetCtl("plug", "uvc");
+  ASSERT_EQ(plug.exitCode, 0) << plug.output;
+  EXPECT_EQ(trimmed(plug.output), dev);
+  const auto stream = test::run({"/usr/bin/v4l2-ctl", "-d", dev, "--stream-mmap", "--stream-count=1"}, {}, 60s);
   EXPECT_EQ(stream.exitCode, 0) << stream.output;
+}
+
+// Makes sure libcamera 0.0.3's UVC pipeline handler finds the camera and captures from it, as
+// Basalt's libcamera backend will: the camera is named after the ACPI node of its PCI USB
+// controller, and frames arrive with the camera's frame numbers. Example failure: udev does not
+// run in the lab, libcamera (which lists only devices udev processed) sees no camera, and every
+// libcamera backend test would skip.
+TEST(LabLibcamera, CamListsAndCapturesTheUvcCamera) {
+  NEED_LAB();
+  if (!fs::exists("/usr/bin/cam")) GTEST_SKIP() << "libcamera's cam is not installed (Debian package libcamera-tools)";
+  if (env("BASALT_VLAB_UDEV") != "1") {
+    GTEST_SKIP() << "libcamera lists only devices udev has processed, and udev does not run in this lab: "
+                 << fixtureLine("udev");
+  }
+  ASSERT_FALSE(uvcNode().empty()) << fixtureLine("uvc");
+  test::run({"/usr/bin/udevadm", "settle", "--timeout=30"}, {}, 40s);
+  const auto list = test::run({"/usr/bin/cam", "-l"}, {}, 60s);
+  ASSERT_EQ(list.exitCode, 0) << list.output;
+  EXPECT_NE(list.output.find("Basalt Lab Camera"), std::string::npos) << list.output;
+  EXPECT_NE(list.output.find("1209:0002"), std::string::npos) << list.output;
+  EXPECT_NE(list.output.find("\\_SB_"), std::string::npos) << "named after the controller's ACPI node:\n"
+                                                           << list.output;
+  const fs::path dir = "/tmp/vlab-cam/";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto run = test::run({"/usr/bin/cam", "-c", "1", "--capture=3", "--file=" + dir.string()}, {}, 120s);
+  ASSERT_EQ(run.exitCode, 0) << run.output;
+  EXPECT_NE(run.output.find("seq: 000002"), std::string::npos) << run.output;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir)) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_EQ(files.size(), 3U) << run.output;
+  std::optional<std::uint32_t> last;
+  for (const auto& f : files) {
+    const auto data = readBytes(f);
+    const auto info = sim::vlab::inspectJpeg(data);
+    ASSERT_TRUE(info) << f << " is not the camera's MJPEG frame (cam's default is its largest MJPEG size)";
+    const auto number = sim::vlab::mjpegFrameNumber(data);
+    ASSERT_TRUE(number) << f;
+    if (last) {
+      EXPECT_GT(*number, *last) << f;
+    }
+    last = number;
+  }
+}
+
+// Makes sure the camera also works through USB/IP, plugged into the guest's own vhci_hcd (as
+// `basalt-vlab-uvc-camera --vhci` does on any Linux machine): uvcvideo binds it and it streams;
+// SIGTERM unplugs it. libcamera 0.0.3 cannot name a camera on vhci_hcd (a platform device with no
+// firmware node: "Can not find controller ID"), which is why the lab's camera goes through qemu.
+// Example failure: the attach is refused because the socket pair's end is closed too early.
+TEST(LabUvc, UsbipCameraOnVhciStreams) {
+  NEED_LAB();
+  const std::string vhci = env("BASALT_VLAB_VHCI");
+  ASSERT_FALSE(vhci.empty()) << fixtureLine("vhci");
+  const std::string program = (test::binaryDir() / "sim" / "vlab" / "basalt-vlab-uvc-camera").string();
+  auto camera = test::Process::start({program, "--vhci", vhci});
+  ASSERT_TRUE(camera.started()) << program;
+  ASSERT_TRUE(camera.waitForOutput("plugged:", 30s)) << camera.outputSoFar();
+  std::string dev;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        std::error_code ec;
+        for (const auto& e : fs::directory_iterator("/sys/class/video4linux", ec)) {
+          if (trimmed(readText(e.path() / "index")) != "0") continue;
+          const fs::path usb = fs::canonical(e.path() / "device", ec).parent_path();
+          if (usb.string().find("vhci_hcd") == std::string::npos) continue;
+          if (trimmed(readText(usb / "idVendor")) != "1209") continue;
+          dev = (fs::path("/dev") / e.path().filename()).string();
+          return true;
+        }
+        return false;
+      },
+      30s))
+      << "no uvcvideo node on vhci_hcd; camera: " << camera.outputSoFar();
+  const fs::path out = "/tmp/vlab-uvc-vhci.yuyv";
+  const auto stream = capture(dev, 320, 240, "YUYV", 3, out);
+  ASSERT_EQ(stream.exitCode, 0) << stream.output;
+  const auto data = readBytes(out);
+  ASSERT_EQ(data.size(), 3U * 320 * 240 * 2);
+  constexpr std::size_t kFrame = std::size_t{320} * 240 * 2;
+  const auto first = sim::vlab::readFrameCounterYuyv(std::span<const std::uint8_t>(data).first(kFrame), 320, 240);
+  const auto third = sim::vlab::readFrameCounterYuyv(std::span<const std::uint8_t>(data).last(kFrame), 320, 240);
+  ASSERT_TRUE(first && third);
+  EXPECT_GT(*third, *first);
+  camera.signal(SIGTERM);
+  const auto done = camera.wait(30s);
+  EXPECT_EQ(done.exitCode, 0) << done.output;
+  EXPECT_TRUE(waitFor([&] { return !fs::exists(dev); }, 15s)) << dev << " is still there after SIGTERM";
 }
 
 // ---- uhid replay of the shared HID recordings: one case per file ---------------------------

@@ -11,8 +11,17 @@ export PATH=/bin:/sbin:/usr/bin:/usr/sbin
 results=$BASALT_VLAB_RESULTS
 hr=/host$results
 say() { echo "basalt-vlab: $*" >/dev/console; }
-fixture_ok() { echo "ok $1 $2" >>"$hr/fixtures"; }
+# timeline: seconds since the kernel started, when each fixture was done (for boot-time figures).
+stamp() {
+  read -r _up _idle </proc/uptime
+  echo "$_up $1" >>"$hr/timeline"
+}
+fixture_ok() {
+  echo "ok $1 $2" >>"$hr/fixtures"
+  stamp "$1"
+}
 fixture_fail() {
+  stamp "$1"
   echo "fail $1 $2" >>"$hr/fixtures"
   say "fixture $1 FAILED: $2"
 }
@@ -27,6 +36,7 @@ stop() {
   stop
 }
 : >"$hr/fixtures"
+stamp start
 # lab.conf (written by the host runner): BASALT_VLAB_SRC, BASALT_VLAB_TOOLS, jobs.
 [ -f "$hr/lab.conf" ] && . "$hr/lab.conf"
 
@@ -38,6 +48,10 @@ env_file=$run_dir/env
   echo "export BASALT_VLAB_RESULTS=$results"
 } >"$env_file"
 setenv() { echo "export $1=$2" >>"$env_file"; }
+in_host() { # runs a command line inside the host root with the lab's environment
+  chroot /host /usr/bin/env -i PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
+    HOME=/root TERM="${TERM:-linux}" LANG=C.UTF-8 /bin/sh -c ". /run/basalt-vlab/env; $1"
+}
 
 load() {
   modprobe "$@" 2>>"$hr/modprobe.log"
@@ -95,6 +109,11 @@ else
   fixture_fail hdmi "modprobe vivid failed"
 fi
 
+# The UVC camera is plugged into qemu's xHCI from the start: load its drivers now, so that it
+# enumerates while the other fixtures are set up (uvc_camera.sh waits for it below).
+load xhci_pci
+load uvcvideo
+
 # ---- uhid ---------------------------------------------------------------------------------
 if load uhid && wait_for 2 test -c /dev/uhid; then
   setenv BASALT_VLAB_UHID 1
@@ -130,8 +149,7 @@ cfs=/sys/kernel/config
 load configfs && { grep -q " $cfs " /proc/mounts || mount -t configfs none $cfs; }
 # The host root's /sys was bind-mounted before configfs existed: mount it there too.
 mount -t configfs none /host$cfs
-load dummy_hcd num=3 && load libcomposite && load usb_f_hid && load usb_f_uvc && load usbhid && load hid_generic &&
-  load uvcvideo
+load dummy_hcd num=2 && load libcomposite && load usb_f_hid && load usbhid && load hid_generic && load uvcvideo
 gadgets=$cfs/usb_gadget
 state=$run_dir/gadgets
 : >"$state"
@@ -235,22 +253,42 @@ else
   fixture_fail powermate "no USB device controller (dummy_hcd) or no configfs usb_gadget"
 fi
 
-# ---- UVC gadget, fed by the frame pump ------------------------------------------------------
-. "/host$BASALT_VLAB_SRC/sim/vlab/guest/uvc_gadget.sh"
+# ---- the UVC camera (on the host, through qemu's usb-redir) and vhci_hcd -------------------
+. "/host$BASALT_VLAB_SRC/sim/vlab/guest/uvc_camera.sh"
+
+# ---- udev: the host's systemd-udevd, as on a real machine --------------------------------
+# libcamera enumerates only devices udevd has processed (libudev's "is initialized" match) and
+# learns of hotplug from udevd; other programs that use libudev do too. Started once the
+# fixtures exist (started first, its start-up slows theirs down under TCG). The lab's programs
+# run in a chroot, which systemd's tools refuse to work in unless told to ignore it.
+# udevd gets the rules for devices and cameras only (permissions, /dev/v4l links): the host's
+# full set, parsed and run under TCG, would add seconds to every boot for devices no test reads.
+setenv SYSTEMD_IGNORE_CHROOT 1
+udev_rules=/host/usr/lib/udev/rules.d
+mkdir -p /host/run/basalt-vlab/udev-rules
+for r in 50-udev-default.rules 60-persistent-v4l.rules; do
+  [ -f "$udev_rules/$r" ] && cp "$udev_rules/$r" /host/run/basalt-vlab/udev-rules/
+done
+[ -d "$udev_rules" ] && mount --bind /host/run/basalt-vlab/udev-rules "$udev_rules"
+if ! in_host "test -x /lib/systemd/systemd-udevd"; then
+  fixture_fail udev "the host has no systemd-udevd (Debian package udev; scripts/setup.sh): libcamera sees no camera without it"
+elif in_host "/lib/systemd/systemd-udevd --daemon && udevadm trigger --settle --action=add --subsystem-match=video4linux --subsystem-match=media" >"$hr/udev.log" 2>&1; then
+  setenv BASALT_VLAB_UDEV 1
+  fixture_ok udev "systemd-udevd runs; video4linux and media devices processed"
+else
+  fixture_fail udev "systemd-udevd did not start or settle: $(tail -1 "$hr/udev.log")"
+fi
 
 setenv BASALT_VLAB_GADGET_CTL "$BASALT_VLAB_SRC/sim/vlab/guest/gadget-ctl"
 if [ -n "$BASALT_VLAB_TOOLS" ] && [ -x "/host$BASALT_VLAB_TOOLS/basalt-vlab-hid-replay" ]; then
   setenv BASALT_VLAB_HID_REPLAY "$BASALT_VLAB_TOOLS/basalt-vlab-hid-replay"
 fi
 cp "$env_file" "$hr/lab.env"
+stamp ready
 say "fixtures ready"
 : >"$hr/ready"
 
 # ---- jobs, or a shell ---------------------------------------------------------------------
-in_host() { # runs a command line inside the host root with the lab's environment
-  chroot /host /usr/bin/env -i PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
-    HOME=/root TERM="${TERM:-linux}" LANG=C.UTF-8 /bin/sh -c ". /run/basalt-vlab/env; $1"
-}
 
 if [ "$BASALT_VLAB_MODE" = shell ]; then
   say "interactive lab shell: the host's root, the lab's devices; 'exit' powers off"
