@@ -94,8 +94,10 @@ std::vector<std::uint8_t> sequence(std::size_t n) {
 }
 
 /// Decodes a JPEG file's bytes with OpenImageIO (libjpeg underneath).
+// Each call has a folder of its own: ctest runs the cases in parallel processes, and scratchDir()
+// empties the folder it gives.
 Result<Image> decodeJpeg(std::span<const std::uint8_t> jpeg, const std::string& name) {
-  const auto path = test::scratchDir("uvc_camera_test") / (name + ".jpg");
+  const auto path = test::scratchDir("uvc_camera_test-" + name) / (name + ".jpg");
   std::ofstream(path, std::ios::binary)
       .write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
   return media::readImage(path);
