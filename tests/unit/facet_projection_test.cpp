@@ -17,6 +17,7 @@
 #include <string>
 #include <utility>
 
+#include "runtime/cave_keys.h"
 #include "runtime/facet_projection.h"
 #include "runtime/formats/cave.h"
 #include "support/polyhedra.h"
@@ -251,6 +252,55 @@ TEST(FacetProjection, AViewerBehindTheFacetIsNotVisibleAndGivesNoNaN) {
   degenerate.corners = {{0, 0, 0}, {1, 0, 0}};
   FacetProjection p;
   EXPECT_FALSE(computeFacetView(degenerate, in, p));
+}
+
+}  // namespace
+}  // namespace basalt::runtime
+
+// The thesis' adjustment keys (Appendix B) on Linux key codes, shift from the shift keys' own
+// events. Example failure: shift stuck after its release (m changes Xscale); a side index past
+// the facet's corners saved into the cave file (which then no longer loads).
+namespace basalt::runtime {
+namespace {
+
+Event key(std::uint16_t code, double value = 1) {
+  Event e;
+  e.kind = EventKind::kKey;
+  e.index = code;
+  e.value = value;
+  return e;
+}
+
+TEST(CaveKeys, AppendixBKeysAdjustTheCalibration) {
+  std::vector<formats::Diagnostic> warnings;
+  auto g = formats::parseCaveGeometry(test::prismDisplayObj(), "prism.obj", {}, warnings);
+  ASSERT_TRUE(g);
+  CaveKeys keys;
+  formats::CaveSettings cave;
+  float spacing = 0.06f;
+  EXPECT_EQ(keys.apply(key(50), cave, *g, spacing), CaveKeyEffect::kCalibration);  // m: Yscale large down
+  EXPECT_FLOAT_EQ(cave.yScale, 0.9f);
+  EXPECT_FLOAT_EQ(cave.xScale, 1.0f);
+  keys.apply(key(42), cave, *g, spacing);  // left shift down
+  keys.apply(key(53), cave, *g, spacing);  // ?: Xscale large up
+  EXPECT_FLOAT_EQ(cave.xScale, 1.1f);
+  keys.apply(key(39), cave, *g, spacing);  // ':' Xskew small up
+  EXPECT_FLOAT_EQ(cave.xSkew, 0.5f);
+  keys.apply(key(27), cave, *g, spacing);  // '}' eye spacing large up
+  EXPECT_FLOAT_EQ(spacing, 0.07f);
+  for (int i = 0; i < 5; ++i) keys.apply(key(31), cave, *g, spacing);  // S five times on a 4-sided wall
+  EXPECT_EQ(cave.side, 1u);
+  keys.apply(key(42, 0), cave, *g, spacing);  // shift released
+  keys.apply(key(38), cave, *g, spacing);     // l: Yskew small down
+  EXPECT_FLOAT_EQ(cave.ySkew, -0.5f);
+  EXPECT_FLOAT_EQ(cave.xSkew, 0.5f);
+  EXPECT_EQ(keys.apply(key(31), cave, *g, spacing), CaveKeyEffect::kNone);  // plain s is not S
+  keys.apply(key(109), cave, *g, spacing);                                  // PgDown from 0 wraps
+  EXPECT_EQ(cave.facet, 9u);
+  EXPECT_EQ(cave.side, 0u);
+  keys.apply(key(107), cave, *g, spacing);  // End: long side to the top
+  EXPECT_FLOAT_EQ(cave.zRotation, 180.0f);
+  EXPECT_EQ(keys.apply(key(50, 0), cave, *g, spacing), CaveKeyEffect::kNone);  // releases change nothing
 }
 
 }  // namespace
