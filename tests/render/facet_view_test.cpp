@@ -59,7 +59,7 @@ class FacetViews : public RenderTest {
 
   Image drawFacet(const Show& show, const formats::CaveFacet& facet, bool stereo = false,
                   runtime::StereoMode mode = runtime::StereoMode::kAnaglyph, float spacing = 0.2f,
-                  formats::CaveSettings calibration = {}) {
+                  const formats::CaveSettings& calibration = {}) {
     render::FacetPass pass;
     pass.facet = &facet;
     pass.input.worldFromCave = runtime::cavePlacement(show);
@@ -163,8 +163,8 @@ TEST_F(FacetViews, StereoLayoutsPutEachEyeInItsPlace) {
   EXPECT_GT(diff, 0u) << "the two eyes see the same picture: no eye spacing";
   // Top and bottom: both halves show the cube (not background) at their centres.
   const auto notBackground = [](const Image& im, std::uint32_t x, std::uint32_t y) {
-    return std::abs(im.at(x, y, 0) - static_cast<int>(0.3 * 255 + 0.5)) > 3 ||
-           std::abs(im.at(x, y, 2) - static_cast<int>(0.5 * 255 + 0.5)) > 3;
+    return std::abs(im.at(x, y, 0) - static_cast<int>(std::lround(0.3 * 255))) > 3 ||
+           std::abs(im.at(x, y, 2) - static_cast<int>(std::lround(0.5 * 255))) > 3;
   };
   EXPECT_TRUE(notBackground(topBottom, kRenderSize / 2, kRenderSize / 4));
   EXPECT_TRUE(notBackground(topBottom, kRenderSize / 2, 3 * kRenderSize / 4));

@@ -20,6 +20,7 @@
 #include "runtime/cave_keys.h"
 #include "runtime/facet_projection.h"
 #include "runtime/formats/cave.h"
+#include "runtime/navigation.h"
 #include "support/polyhedra.h"
 
 namespace basalt::runtime {
@@ -301,6 +302,66 @@ TEST(CaveKeys, AppendixBKeysAdjustTheCalibration) {
   keys.apply(key(107), cave, *g, spacing);  // End: long side to the top
   EXPECT_FLOAT_EQ(cave.zRotation, 180.0f);
   EXPECT_EQ(keys.apply(key(50, 0), cave, *g, spacing), CaveKeyEffect::kNone);  // releases change nothing
+}
+
+}  // namespace
+}  // namespace basalt::runtime
+
+// Navigation (thesis §5.1, Appendix B, §4.6): held arrow keys move the viewer at the scene's
+// speed along its heading, pointer motion pans and tilts, the map bounds hold, and on a terrain
+// the eye follows the ground. Example failures: forward moving along +Z; a tilt past vertical;
+// the viewer walking through a hill at its old height.
+namespace basalt::runtime {
+namespace {
+
+TEST(Navigation, ArrowKeysWalkThePointerTurnsAndTheTerrainCarries) {
+  Show show;
+  Viewer& v = show.viewer();
+  v.positionSpeed = 2.0f;
+  v.rotationSpeed = 0.5f;
+  Navigator nav(1.5f);
+  EXPECT_TRUE(nav.apply(key(103), show));  // up arrow held
+  nav.advance(0.5, show);
+  EXPECT_NEAR(v.position.z, -1.0f, 1e-6f);
+  EXPECT_NEAR(v.position.x, 0.0f, 1e-6f);
+  nav.apply(key(103, 0), show);
+  Event pan;
+  pan.kind = EventKind::kPointerMotion;
+  pan.index = 0;
+  pan.value = -180;  // pointer 180 px left: turn left by 90 degrees
+  EXPECT_TRUE(nav.apply(pan, show));
+  EXPECT_NEAR(v.rotation.y, 90.0f, 1e-4f);
+  nav.apply(key(103), show);
+  nav.advance(0.5, show);  // heading +90: forward is -X
+  EXPECT_NEAR(v.position.x, -1.0f, 1e-5f);
+  pan.index = 1;
+  pan.value = -1000;
+  nav.apply(pan, show);
+  EXPECT_FLOAT_EQ(v.rotation.x, -89.0f);  // pointer forward tilts down, clamped short of vertical
+  v.mapMin = {-1.5f, -10, -10};
+  nav.advance(10, show);
+  EXPECT_FLOAT_EQ(v.position.x, -1.5f);  // held at the map's edge
+
+  // A ramp rising along X; the eye stays 1.5 above it.
+  auto ramp = std::make_shared<HeightField>();
+  ramp->columns = 11, ramp->rows = 11, ramp->spacing = 1, ramp->origin = {-5, 0, -5};
+  for (std::uint32_t j = 0; j < 11; ++j) {
+    for (std::uint32_t i = 0; i < 11; ++i) ramp->heights.push_back(static_cast<float>(i) * 0.5f);
+  }
+  SceneNode ground;
+  ground.name = "ground";
+  show.addTerrain(ground, ramp);
+  v.followTerrain = true;
+  v.mapMin = {-1000, -1000, -1000};
+  v.position = {0, 0, 0};
+  v.rotation = {0, -90, 0};  // heading -90: forward is +X
+  nav.advance(1, show);
+  EXPECT_NEAR(v.position.x, 2.0f, 1e-4f);
+  EXPECT_NEAR(v.position.y, (2.0f + 5.0f) * 0.5f + 1.5f, 1e-4f);
+  nav.apply(key(103, 0), show);
+  nav.apply(key(78), show);  // keypad +: up, lost at the next horizontal move
+  nav.advance(1, show);
+  EXPECT_NEAR(v.position.y, 5.0f + 2.0f, 1e-4f);
 }
 
 }  // namespace
