@@ -88,7 +88,7 @@ TEST_F(DisplayViewsTest, CalibrationChangesLiveAndIsSavedToTheCaveFile) {
   EXPECT_TRUE((*views)->applyKey(colon));
   const Image after = draw(**views, show);
   std::size_t changed = 0;
-  for (std::size_t i = 0; i < before.pixels.size(); ++i) changed += before.pixels[i] != after.pixels[i] ? 1 : 0;
+  for (std::size_t i = 0; i < before.pixels.size(); ++i) changed += before.pixels[i] != after.pixels[i] ? 1U : 0U;
   EXPECT_GT(changed, 1000u) << "the calibration did not change the picture";
   ASSERT_TRUE((*views)->saveCalibration(0));
   auto reread = formats::loadCave(folder_ / "display.cave");
