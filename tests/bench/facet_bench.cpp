@@ -114,7 +114,14 @@ int main(int argc, char** argv) {
   benchmark::RegisterBenchmark("plainSix", plainSix)->Unit(benchmark::kMillisecond)->MinTime(minTime);
   benchmark::RegisterBenchmark("facetSix", facetSix)->Unit(benchmark::kMillisecond)->MinTime(minTime);
   return basalt::bench::runBenchmarks(argc, argv, [](const basalt::bench::Medians& m) {
-    const auto one = m.find("plainOne"), six = m.find("plainSix"), facets = m.find("facetSix");
+    // Google Benchmark appends "/min_time:..." to the names.
+    const auto find = [&m](const std::string& name) {
+      for (auto it = m.begin(); it != m.end(); ++it) {
+        if (it->first.rfind(name, 0) == 0) return it;
+      }
+      return m.end();
+    };
+    const auto one = find("plainOne"), six = find("plainSix"), facets = find("facetSix");
     if (one == m.end() || six == m.end() || facets == m.end()) {
       std::printf("facets: no figures (a benchmark failed)\n");
       return;
