@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "kiosk/display_views.h"
 #include "runtime/log.h"
 
 namespace basalt::kiosk {
@@ -32,9 +33,14 @@ Result<void> FrameLoop::renderFrame(FrameContext& context) {
   }
   if (auto r = output_.beginFrame(); !r) return r;
   const render::Size size = output_.size();
-  renderer_.drawShow(show_, {0, 0, size.width, size.height}, [&](runtime::ViewTransforms& view) {
+  const auto adjust = [&](runtime::ViewTransforms& view) {
     for (FrameParticipant* p : participants_) p->adjustView(context, view, size);
-  });
+  };
+  if (viewDrawer_) {
+    viewDrawer_->drawViews(show_, size, adjust);
+  } else {
+    renderer_.drawShow(show_, {0, 0, size.width, size.height}, adjust);
+  }
   for (FrameParticipant* p : participants_) {
     if (auto r = p->afterDraw(context, output_); !r) return r;
   }

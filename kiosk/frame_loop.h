@@ -19,6 +19,8 @@
 
 namespace basalt::kiosk {
 
+class ViewDrawer;  // kiosk/display_views.h
+
 /// \brief What a participant learns about the frame being made.
 struct FrameContext {
   std::int64_t frame = 0;  ///< frame number, from 0
@@ -94,6 +96,9 @@ class FrameLoop {
   /// \brief Adds a participant (borrowed: it must outlive the loop's run()).
   void addParticipant(FrameParticipant& participant) { participants_.push_back(&participant); }
   /// \brief The queue input events arrive in (owned by the caller).
+  /// \brief Draws the frame's views instead of the one plain view (a manifest's `[[views]]`:
+  /// facets, eyes, tiles); borrowed, null for the plain view.
+  void setViewDrawer(ViewDrawer* drawer) { viewDrawer_ = drawer; }
   void setEvents(BoundedQueue<Event>* events, runtime::Bindings* bindings) {
     events_ = events;
     bindings_ = bindings;
@@ -123,6 +128,7 @@ class FrameLoop {
   std::vector<FrameParticipant*> participants_;
   BoundedQueue<Event>* events_ = nullptr;
   runtime::Bindings* bindings_ = nullptr;  // stateful: dial speeds and shuttles
+  ViewDrawer* viewDrawer_ = nullptr;
   Nanos lastInput_{-1};
   bool stopRequested_ = false;
 };

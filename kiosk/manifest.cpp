@@ -741,7 +741,7 @@ class Reader {
       }
       ViewSpec v;
       v.line = lineOf(*t);
-      checkKeys(*t, path, {"name", "kind", "cave", "facet", "eye", "viewport"});
+      checkKeys(*t, path, {"name", "kind", "cave", "facet", "eye", "viewport", "stereo", "eye_spacing", "projection"});
       v.name = string(*t, "name", path).value_or(fmt::format("view {}", index));
       if (!names.insert(v.name).second)
         error(v.line, fmt::format("{}: a view named '{}' already exists", path, v.name));
@@ -762,7 +762,22 @@ class Reader {
           error(lineOf(*cave), fmt::format("{}.cave: must be a file name", path));
         }
       }
-      if (auto facet = integer(*t, "facet", path, 0, 255)) v.facet = static_cast<std::uint32_t>(*facet);
+      if (auto facet = integer(*t, "facet", path, 0, 255)) {
+        v.facet = static_cast<std::uint32_t>(*facet);
+        v.facetGiven = true;
+      }
+      if (auto stereo = choice<ViewSpec::Stereo>(*t, "stereo", path,
+                                                 {{"show", ViewSpec::Stereo::kShow},
+                                                  {"off", ViewSpec::Stereo::kOff},
+                                                  {"anaglyph", ViewSpec::Stereo::kAnaglyph},
+                                                  {"side_by_side", ViewSpec::Stereo::kSideBySide},
+                                                  {"top_bottom", ViewSpec::Stereo::kTopBottom}})) {
+        v.stereo = *stereo;
+      }
+      if (auto spacing = number(*t, "eye_spacing", path, 0.0, 10.0)) v.eyeSpacing = static_cast<float>(*spacing);
+      if (auto projection = choice<bool>(*t, "projection", path, {{"rear", true}, {"front", false}})) {
+        v.rearProjection = *projection;
+      }
       if (auto eye = choice<Eye>(*t, "eye", path, {{"left", Eye::kLeft}, {"right", Eye::kRight}})) v.eye = *eye;
       if (const toml::node* vp = t->get("viewport")) readViewport(*vp, path, v);
       if (v.kind == ViewKind::kFacet && v.cave.empty() && !t->get("cave")) {

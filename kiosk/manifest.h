@@ -98,6 +98,12 @@ struct ViewSpec {
   Eye eye = Eye::kLeft;                                  ///< stereo
   std::optional<std::array<std::uint32_t, 4>> viewport;  ///< x, y, width, height in output pixels
   int line = 0;
+  // Immersive displays (issue 10).
+  bool facetGiven = false;  ///< facet: `facet` was given (else the cave file's facet[] is used)
+  /// plain and facet: how the eyes are shown; "show" follows the show's stereo setting
+  enum class Stereo : std::uint8_t { kShow, kOff, kAnaglyph, kSideBySide, kTopBottom } stereo = Stereo::kShow;
+  std::optional<float> eyeSpacing;  ///< facet: distance between the eyes in cave units (default: the show's)
+  bool rearProjection = true;       ///< facet: `projection = "rear"` (the thesis' default) or "front"
 };
 
 /// \brief What a show entry, playlist item or standby item plays.

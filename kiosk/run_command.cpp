@@ -15,6 +15,7 @@
 
 #include "kiosk/commands.h"
 #include "kiosk/device_wiring.h"
+#include "kiosk/display_views.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/frame_metrics.h"
 #include "kiosk/manifest.h"
@@ -534,6 +535,15 @@ int runShow(const RunOptions& options) {
       // The show matters more than its status page.
       log::error(kLogRun, "{}; the show plays without it", started.error().describe());
     }
+  }
+
+  // [[views]]: facets of an immersive display, stereo eyes, tiles (one plain view without).
+  std::unique_ptr<DisplayViews> views;
+  if (!manifest.views.empty()) {
+    auto made = DisplayViews::create(manifest.views, **renderer, (*output)->size());
+    if (!made) return failWith(made.error(), "cannot set up the show's views");
+    views = std::move(*made);
+    frameLoop.setViewDrawer(views.get());
   }
 
   FrameMetrics metrics(board, &events, (*output)->describe());

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "render/attribute_tables.h"
+#include "render/facet_view.h"
 #include "render/frame_block.h"
 #include "render/gpu_mesh.h"
 #include "render/shader_programs.h"
@@ -1015,8 +1016,19 @@ void Renderer::drawShow(const Show& show, const Viewport& viewport,
   };
   if (show.global().stereo) {
     const float half = 0.5f * show.stereo().eyeSpacing;
-    drawAnaglyph(show, adjusted(runtime::computeEyeView(show, aspect, -half)),
-                 adjusted(runtime::computeEyeView(show, aspect, half)), viewport);
+    const runtime::ViewTransforms left = adjusted(runtime::computeEyeView(show, aspect, -half));
+    const runtime::ViewTransforms right = adjusted(runtime::computeEyeView(show, aspect, half));
+    if (show.stereo().mode == runtime::StereoMode::kAnaglyph) {
+      drawAnaglyph(show, left, right, viewport);
+      return;
+    }
+    // Passive stereo: each eye squeezed into its half at the whole viewport's aspect ratio.
+    const std::array<Viewport, 2> eyes = stereoViewports(viewport, show.stereo().mode);
+    ViewPass pass;
+    pass.viewport = eyes[0];
+    draw(show, left, pass);
+    pass.viewport = eyes[1];
+    draw(show, right, pass);
     return;
   }
   ViewPass pass;

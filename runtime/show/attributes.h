@@ -403,7 +403,9 @@ enum class DeferralMode : std::uint8_t { kAsti, kAsap };
 
 /// \brief How `global.stereo_mode = on` is shown. With no stereo display the object "gets drawn
 /// twice into the same buffer" (LAVA §6.1): Basalt draws a red/cyan anaglyph (thesis §5.1).
-enum class StereoMode : std::uint8_t { kAnaglyph };
+/// Passive projectors take the two eyes side by side (left eye on the left) or top and bottom
+/// (left eye on top), each squeezed into half the output (the frame-compatible formats).
+enum class StereoMode : std::uint8_t { kAnaglyph, kSideBySide, kTopBottom };
 
 /// \brief Thesis §5.1 stereo: two eyes `eyeSpacing` apart (thesis C.3 `eyespacing`, default
 /// 0.04), left eye red, right eye cyan, converging on the object's centre plane.

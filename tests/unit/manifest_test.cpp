@@ -102,7 +102,7 @@ TEST_P(ExampleShow, IsValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Configs, ExampleShow,
-                         testing::Values("default", "video-wall", "camera-sculpture", "lava-script"));
+                         testing::Values("default", "video-wall", "camera-sculpture", "lava-script", "cube-cave"));
 
 TEST(ExampleShows, EachHasWhatItsDescriptionSays) {
   const fs::path shows = test::sourceDir() / "configs/shows";
@@ -156,7 +156,7 @@ TEST(ExampleShows, EachHasWhatItsDescriptionSays) {
 }
 
 TEST(ExampleShows, BasaltCheckAcceptsEveryExample) {
-  for (const char* name : {"default", "video-wall", "camera-sculpture", "lava-script"}) {
+  for (const char* name : {"default", "video-wall", "camera-sculpture", "lava-script", "cube-cave"}) {
     const auto file = test::sourceDir() / "configs/shows" / name / "show.toml";
     const auto r = test::run({(test::binaryDir() / "basalt").string(), "check", file.string()});
     EXPECT_EQ(r.exitCode, 0) << r.output;

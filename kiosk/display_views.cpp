@@ -1,0 +1,150 @@
+#include "kiosk/display_views.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "runtime/log.h"
+
+namespace basalt::kiosk {
+namespace {
+BASALT_LOG_CATEGORY(Views, "views");
+}  // namespace
+
+Result<std::unique_ptr<DisplayViews>> DisplayViews::create(const std::vector<ViewSpec>& specs,
+                                                           render::Renderer& renderer, render::Size output) {
+  auto facets = render::FacetRenderer::create();
+  if (!facets) return std::unexpected(facets.error());
+  std::unique_ptr<DisplayViews> d(new DisplayViews(renderer, std::move(*facets)));
+  std::size_t untiled = 0;
+  for (const ViewSpec& s : specs) untiled += s.viewport ? 0U : 1U;
+  const auto columns = static_cast<std::uint32_t>(std::ceil(std::sqrt(static_cast<double>(untiled))));
+  const std::uint32_t rows = columns == 0 ? 0 : static_cast<std::uint32_t>((untiled + columns - 1) / columns);
+  std::uint32_t tile = 0;
+  bool currentSet = false;
+  for (const ViewSpec& s : specs) {
+    View v;
+    v.spec = s;
+    if (s.viewport) {
+      const auto& r = *s.viewport;  // x, y from the top left in the manifest
+      v.viewport = {static_cast<std::int32_t>(r[0]), static_cast<std::int32_t>(output.height - r[1] - r[3]), r[2],
+                    r[3]};
+    } else {
+      const std::uint32_t c = tile % columns, r = tile / columns;
+      const std::uint32_t x0 = output.width * c / columns, x1 = output.width * (c + 1) / columns;
+      const std::uint32_t y0 = output.height * r / rows, y1 = output.height * (r + 1) / rows;
+      v.viewport = {static_cast<std::int32_t>(x0), static_cast<std::int32_t>(output.height - y1), x1 - x0, y1 - y0};
+      ++tile;
+    }
+    if (s.kind == ViewKind::kFacet) {
+      auto cave = formats::loadCave(s.cave);
+      if (!cave) return std::unexpected(cave.error());
+      if (!cave->geometry) {
+        return fail(Errc::kInvalidArgument,
+                    fmt::format("view '{}': the cave file names no display geometry: add `model display.obj`", s.name),
+                    s.cave.string());
+      }
+      if (s.facetGiven) {
+        if (s.facet >= cave->geometry->facets.size()) {
+          return fail(Errc::kInvalidArgument,
+                      fmt::format("view '{}': facet {} does not exist; the display has facets 0 to {}", s.name, s.facet,
+                                  cave->geometry->facets.size() - 1),
+                      s.cave.string());
+        }
+        cave->settings.facet = s.facet;
+      }
+      v.cave = std::move(*cave);
+      if (s.eyeSpacing) v.eyeSpacing = *s.eyeSpacing;
+      if (!currentSet) d->current_ = d->views_.size(), currentSet = true;
+    }
+    d->views_.push_back(std::move(v));
+  }
+  return d;
+}
+
+void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
+                             const std::function<void(runtime::ViewTransforms&)>& adjust) {
+  (void)output;
+  for (View& v : views_) {
+    const render::Viewport& vp = v.viewport;
+    switch (v.spec.kind) {
+      case ViewKind::kPlain: renderer_.drawShow(show, vp, adjust); break;
+      case ViewKind::kStereo: {
+        // One eye of the show's stereo pair, filling the view: a passive projector per eye.
+        const float aspect = static_cast<float>(std::max(vp.width, 1U)) / static_cast<float>(std::max(vp.height, 1U));
+        const float half = 0.5f * show.stereo().eyeSpacing;
+        runtime::ViewTransforms t = runtime::computeEyeView(show, aspect, v.spec.eye == Eye::kLeft ? -half : half);
+        if (adjust) adjust(t);
+        render::ViewPass pass;
+        pass.viewport = vp;
+        renderer_.draw(show, t, pass);
+        break;
+      }
+      case ViewKind::kFacet: {
+        const formats::CaveGeometry& g = *v.cave.geometry;
+        const std::uint32_t index = v.cave.settings.facet < g.facets.size() ? v.cave.settings.facet : 0;
+        render::FacetPass pass;
+        pass.facet = &g.facets[index];
+        pass.input.calibration = v.cave.settings;
+        pass.input.worldFromCave = runtime::cavePlacement(show);
+        pass.input.farDistance = show.viewer().farClip;
+        pass.input.rearProjection = v.spec.rearProjection;
+        pass.viewport = vp;
+        using S = ViewSpec::Stereo;
+        switch (v.spec.stereo) {
+          case S::kShow:
+            pass.stereo = show.global().stereo;
+            pass.stereoMode = show.stereo().mode;
+            break;
+          case S::kOff: pass.stereo = false; break;
+          case S::kAnaglyph: pass.stereo = true, pass.stereoMode = runtime::StereoMode::kAnaglyph; break;
+          case S::kSideBySide: pass.stereo = true, pass.stereoMode = runtime::StereoMode::kSideBySide; break;
+          case S::kTopBottom: pass.stereo = true, pass.stereoMode = runtime::StereoMode::kTopBottom; break;
+        }
+        pass.eyeSpacing = v.eyeSpacing >= 0 ? v.eyeSpacing : show.stereo().eyeSpacing;
+        if (auto r = facets_->draw(renderer_, show, pass, adjust); !r && !v.warned) {
+          log::error(kLogViews, "view '{}': facet {} of {}: {}", v.spec.name, index, v.spec.cave.string(),
+                     r.error().message());
+          v.warned = true;
+        }
+        v.last = facets_->lastProjection();
+        break;
+      }
+    }
+  }
+}
+
+bool DisplayViews::selectView(std::size_t index) {
+  if (index >= views_.size() || views_[index].spec.kind != ViewKind::kFacet) return false;
+  current_ = index;
+  return true;
+}
+
+bool DisplayViews::applyKey(const Event& event) {
+  if (current_ >= views_.size() || views_[current_].spec.kind != ViewKind::kFacet) return false;
+  View& v = views_[current_];
+  float spacing = v.eyeSpacing >= 0 ? v.eyeSpacing : 0.0f;
+  const runtime::CaveKeyEffect effect = keys_.apply(event, v.cave.settings, *v.cave.geometry, spacing);
+  if (effect == runtime::CaveKeyEffect::kEyeSpacing) v.eyeSpacing = spacing;
+  return effect != runtime::CaveKeyEffect::kNone;
+}
+
+formats::CaveSettings* DisplayViews::calibration(std::size_t index) {
+  if (index >= views_.size() || views_[index].spec.kind != ViewKind::kFacet) return nullptr;
+  return &views_[index].cave.settings;
+}
+
+Result<void> DisplayViews::saveCalibration(std::size_t index) const {
+  if (index >= views_.size() || views_[index].spec.kind != ViewKind::kFacet) {
+    return fail(Errc::kInvalidArgument, fmt::format("view {} is not a facet view", index));
+  }
+  const View& v = views_[index];
+  return formats::writeCave(v.cave.path, v.cave.settings);
+}
+
+const runtime::FacetProjection* DisplayViews::lastProjection(std::size_t index) const {
+  if (index >= views_.size() || views_[index].spec.kind != ViewKind::kFacet) return nullptr;
+  return &views_[index].last;
+}
+
+}  // namespace basalt::kiosk

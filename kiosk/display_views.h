@@ -1,0 +1,76 @@
+#pragma once
+
+/// \file
+/// \brief The views a show manifest asks for (`[[views]]`), drawn each frame: plain views, one
+/// stereo eye per view (a passive projector per eye), and facets of a polyhedral display
+/// (thesis §4.4) in mono or any stereo layout, tiled in one output or each filling an output.
+/// Holds each facet view's calibration, adjustable live with the thesis' keys (Appendix B) and
+/// saved back to its `.cave` file.
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "kiosk/manifest.h"
+#include "render/facet_view.h"
+#include "render/renderer.h"
+#include "runtime/cave_keys.h"
+#include "runtime/formats/cave.h"
+
+namespace basalt::kiosk {
+
+/// \brief Draws the frame instead of the single plain view (FrameLoop::setViewDrawer).
+class ViewDrawer {
+ public:
+  virtual ~ViewDrawer() = default;
+  virtual void drawViews(const runtime::Show& show, render::Size output,
+                         const std::function<void(runtime::ViewTransforms&)>& adjust) = 0;
+};
+
+/// \brief A manifest's views, ready to draw.
+///
+/// Threading: the frame loop's thread (it draws with GL).
+class DisplayViews final : public ViewDrawer {
+ public:
+  /// \brief Loads each facet view's cave file and checks its facet; views without a viewport
+  /// are tiled over the output (a grid, left to right, top to bottom). Needs the GL context.
+  [[nodiscard]] static Result<std::unique_ptr<DisplayViews>> create(const std::vector<ViewSpec>& views,
+                                                                    render::Renderer& renderer, render::Size output);
+
+  void drawViews(const runtime::Show& show, render::Size output,
+                 const std::function<void(runtime::ViewTransforms&)>& adjust) override;
+
+  /// \brief A keyboard event for the calibration keys; they act on the current facet view
+  /// (the first, or the one chosen with selectView). True when something changed.
+  bool applyKey(const Event& event);
+  /// \brief The view the calibration keys act on; false when `index` is not a facet view.
+  bool selectView(std::size_t index);
+  /// \brief The calibration of view `index` (a facet view), to read or change live.
+  [[nodiscard]] formats::CaveSettings* calibration(std::size_t index);
+  /// \brief Writes view `index`'s calibration back to its cave file.
+  [[nodiscard]] Result<void> saveCalibration(std::size_t index) const;
+  /// \brief The projection drawn last for view `index` (facet views).
+  [[nodiscard]] const runtime::FacetProjection* lastProjection(std::size_t index) const;
+  [[nodiscard]] std::size_t size() const { return views_.size(); }
+
+ private:
+  struct View {
+    ViewSpec spec;
+    render::Viewport viewport;  ///< GL coordinates (from the bottom left)
+    formats::LoadedCave cave;   ///< facet views
+    runtime::FacetProjection last;
+    float eyeSpacing = -1;  ///< facet views: < 0 follows the show
+    bool warned = false;
+  };
+  DisplayViews(render::Renderer& renderer, std::unique_ptr<render::FacetRenderer> facets)
+      : renderer_(renderer), facets_(std::move(facets)) {}
+
+  render::Renderer& renderer_;
+  std::unique_ptr<render::FacetRenderer> facets_;
+  std::vector<View> views_;
+  std::size_t current_ = 0;
+  runtime::CaveKeys keys_;
+};
+
+}  // namespace basalt::kiosk

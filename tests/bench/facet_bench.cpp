@@ -1,0 +1,137 @@
+// Immersive displays (issue 10, "Speed"): six facet views drawn by one node, each a 1280 x 720
+// picture (one per projector), against the same scene drawn as plain views, headless.
+//  - plainOne: the default show as one plain view (what one node draws without facets);
+//  - plainSix: the same plain view drawn six times (the extra draw work six pictures cost);
+//  - facetSix: six facet views of the cube display's front wall (the same scene in the same
+//    pixels, so the draw work matches plainSix): the projection per facet and the border pass.
+// Figure: facetSix / plainSix - 1, the facet machinery's cost beyond the extra draw work;
+// target under 10 %. Each frame ends in glFinish(), so llvmpipe's work is counted.
+
+#include <benchmark/benchmark.h>
+
+#include <GLES3/gl3.h>
+
+#include <cstdio>
+#include <string_view>
+
+#include "bench_main.h"
+#include "render/facet_view.h"
+#include "render/output.h"
+#include "render/renderer.h"
+#include "runtime/formats/cave.h"
+#include "runtime/show/show.h"
+
+namespace {
+
+using namespace basalt;
+
+constexpr std::uint32_t kWidth = 1280, kHeight = 720;
+
+// The cube display -1..1, facet 5 faces +Z (the wall ahead of the viewer).
+constexpr const char* kCube =
+    "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\n"
+    "f 1 2 3 4\n";
+
+struct Bench {
+  std::unique_ptr<render::Output> output;
+  std::unique_ptr<render::Renderer> renderer;
+  std::unique_ptr<render::FacetRenderer> facets;
+  formats::CaveGeometry geometry;
+  runtime::Show show = runtime::Show::makeDefault();
+  std::string problem;
+};
+
+Bench& bench() {
+  static Bench b = [] {
+    Bench x;
+    auto output = render::createHeadlessOutput({kWidth, kHeight});
+    if (!output) return x.problem = output.error().describe(), std::move(x);
+    x.output = std::move(*output);
+    auto renderer = render::Renderer::create();
+    if (!renderer) return x.problem = renderer.error().describe(), std::move(x);
+    x.renderer = std::move(*renderer);
+    auto facets = render::FacetRenderer::create();
+    if (!facets) return x.problem = facets.error().describe(), std::move(x);
+    x.facets = std::move(*facets);
+    std::vector<formats::Diagnostic> warnings;
+    auto g = formats::parseCaveGeometry(kCube, "wall.obj", {}, warnings);
+    if (!g) return x.problem = g.error().describe(), std::move(x);
+    x.geometry = std::move(*g);
+    return x;
+  }();
+  return b;
+}
+
+void frame(benchmark::State& state, int views, bool facet) {
+  Bench& b = bench();
+  if (!b.problem.empty()) {
+    state.SkipWithError(b.problem.c_str());
+    return;
+  }
+  const render::Viewport vp{0, 0, kWidth, kHeight};
+  render::FacetPass pass;
+  pass.facet = &b.geometry.facets[0];
+  pass.input.worldFromCave = runtime::cavePlacement(b.show);
+  pass.viewport = vp;
+  for (auto _ : state) {
+    for (int i = 0; i < views; ++i) {
+      if (!b.output->beginFrame()) {
+        state.SkipWithError("the output cannot begin a frame");
+        return;
+      }
+      if (facet) {
+        if (!b.facets->draw(*b.renderer, b.show, pass)) {
+          state.SkipWithError("the facet view cannot be drawn");
+          return;
+        }
+      } else {
+        b.renderer->drawShow(b.show, vp);
+      }
+      glFinish();
+    }
+  }
+}
+
+void plainOne(benchmark::State& state) { frame(state, 1, false); }
+void plainSix(benchmark::State& state) { frame(state, 6, false); }
+void facetSix(benchmark::State& state) { frame(state, 6, true); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool quick = false;
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string_view(argv[i]) == "--quick") {
+      quick = true;
+    } else {
+      argv[kept++] = argv[i];
+    }
+  }
+  argc = kept;
+  const double minTime = quick ? 0.2 : 2.0;
+  benchmark::RegisterBenchmark("plainOne", plainOne)->Unit(benchmark::kMillisecond)->MinTime(minTime);
+  benchmark::RegisterBenchmark("plainSix", plainSix)->Unit(benchmark::kMillisecond)->MinTime(minTime);
+  benchmark::RegisterBenchmark("facetSix", facetSix)->Unit(benchmark::kMillisecond)->MinTime(minTime);
+  return basalt::bench::runBenchmarks(argc, argv, [](const basalt::bench::Medians& m) {
+    // Google Benchmark appends "/min_time:..." to the names.
+    const auto find = [&m](const std::string& name) {
+      for (auto it = m.begin(); it != m.end(); ++it) {
+        if (it->first.rfind(name, 0) == 0) return it;
+      }
+      return m.end();
+    };
+    const auto one = find("plainOne"), six = find("plainSix"), facets = find("facetSix");
+    if (one == m.end() || six == m.end() || facets == m.end()) {
+      std::printf("facets: no figures (a benchmark failed)\n");
+      return;
+    }
+    const double overhead = facets->second / six->second - 1.0;
+    std::printf(
+        "facets: 6 facet views at 1280x720 each %.2f ms/frame (%.1f fps); the same scene as 6 plain views %.2f ms "
+        "(%.1f fps), as one plain view %.2f ms (%.1f fps); facet machinery beyond the extra draw work %+.1f %%; "
+        "target < 10 %%: %s\n",
+        facets->second * 1e3, 1.0 / facets->second, six->second * 1e3, 1.0 / six->second, one->second * 1e3,
+        1.0 / one->second, overhead * 100.0, overhead < 0.10 ? "met" : "NOT MET");
+  });
+}
