@@ -11,6 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <random>
@@ -47,6 +50,20 @@ class LogCapture {
  private:
   std::shared_ptr<log::RingSink> sink_;
 };
+
+/// The full path of a program on PATH (the test's process helper does not search PATH), or empty.
+std::string onPath(std::string_view program) {
+  const char* path = std::getenv("PATH");
+  std::string_view dirs = path ? path : "/usr/bin:/bin";
+  while (!dirs.empty()) {
+    const auto colon = dirs.find(':');
+    const std::filesystem::path candidate = std::filesystem::path(dirs.substr(0, colon)) / program;
+    if (access(candidate.c_str(), X_OK) == 0) return candidate.string();
+    if (colon == std::string_view::npos) break;
+    dirs.remove_prefix(colon + 1);
+  }
+  return {};
+}
 
 /// Plays `player` from show time `t` for `frames` show frames; returns the frame numbers shown.
 std::vector<int> playFrames(MoviePlayer& player, Nanos& t, int frames) {
