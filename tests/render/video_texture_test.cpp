@@ -150,7 +150,7 @@ TEST_F(VideoTextures, ZoomDialsMoveTheZoomPictureOfAShow) {
   // wires it: the dials' turns go through the show's Bindings (move_zoom_x/y) to VideoStreams,
   // which draws the picture at its new place on the next frame.
   // Failure caught: moveZoom with nothing calling it; dials that turn the object instead.
-  const auto file = clip("zoom-dials.mkv", 30, 30, media::VideoCodec::kH264, 40);
+  const auto file = clip("zoom-dials-40.mkv", 30, 30, media::VideoCodec::kH264, 40);
   auto renderer = Renderer::create();
   ASSERT_TRUE(renderer);
   runtime::Show show = runtime::Show::makeDefault();
