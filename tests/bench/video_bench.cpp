@@ -310,11 +310,15 @@ std::int64_t droppedWithStreams(const std::filesystem::path& file, int count, do
   for (int n = 0; n < frames; ++n) {
     const Nanos due = frameTime(n, 30);
     while (clock.now() - start < due) std::this_thread::sleep_for(std::chrono::microseconds(500));
+    // Streams convert into their own textures first (update() leaves framebuffer 0 bound, which
+    // a surfaceless output does not have); then the output's frame draws them.
+    for (int i = 0; i < count; ++i) {
+      const auto idx = static_cast<std::size_t>(i);
+      if (auto r = streams[idx]->update(players[idx]->frameAt(due)); !r) return failed(r.error().describe());
+    }
     if (auto r = (*output)->beginFrame(); !r) return failed(r.error().describe());
     for (int i = 0; i < count; ++i) {
       const auto idx = static_cast<std::size_t>(i);
-      const FrameRef f = players[idx]->frameAt(due);
-      if (auto r = streams[idx]->update(f); !r) return failed(r.error().describe());
       const float w = 1280.0f / static_cast<float>(count);
       (*overlay)->draw(streams[idx]->view(), {w * static_cast<float>(i), 0, w, 720}, (*output)->size());
       const std::int64_t now = players[idx]->currentFrame();
