@@ -1121,7 +1121,9 @@ class Reader {
       case runtime::Action::kTranslateX:
       case runtime::Action::kTranslateY:
       case runtime::Action::kTranslateZ: return 1;
-      case runtime::Action::kNone: return 0;
+      case runtime::Action::kNone:
+      case runtime::Action::kMoveZoomX:  // the Zoom dials are `basalt run --zoom-dials`, not manifests
+      case runtime::Action::kMoveZoomY: return 0;
     }
     return 0;
   }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -129,6 +130,8 @@ Options:
   --zoom PART[=SCALE][@X,Y]
                      show PART's movie as a picture over the scene (LAVA's Zoom): SCALE of
                      its size (default 0.5), top-left corner at X,Y pixels (default 10,10)
+  --zoom-dials X,Y   dials X and Y move the Zoom pictures across and down (LAVA's Shift +
+                     drag), a full turn the output's width or height; with --replay
   --audio            play the movies' sound on the default output
   --record PATH      record the rendered output to PATH (.mp4, .mkv, .mov, .avi, .webm)
   --record-codec C   h264, mjpeg, vp8, vp9 or auto (H.264; MJPEG for .avi; VP9 for .webm)
@@ -187,6 +190,7 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--movie", true},
                               {"--movie-once"},
                               {"--zoom", true},
+                              {"--zoom-dials", true},
                               {"--audio"},
                               {"--record", true},
                               {"--record-codec", true},
@@ -274,6 +278,22 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       auto z = parseZoomOption(o.value);
       if (!z) return std::unexpected(z.error());
       run.zooms.push_back(std::move(*z));
+    } else if (o.name == "--zoom-dials") {
+      int x = -1;
+      int y = -1;
+      const auto comma = o.value.find(',');
+      const auto number = [](std::string_view t, int& out) {
+        const auto r = std::from_chars(t.data(), t.data() + t.size(), out);
+        return r.ec == std::errc{} && r.ptr == t.data() + t.size() && out >= 0 &&
+               out < static_cast<int>(runtime::kMaxBoundDials);
+      };
+      if (comma == std::string_view::npos || !number(o.value.substr(0, comma), x) ||
+          !number(o.value.substr(comma + 1), y) || x == y) {
+        return fail(Errc::kInvalidArgument,
+                    fmt::format("--zoom-dials needs two different dial numbers from 0 to {}, like 6,7 (got '{}')",
+                                runtime::kMaxBoundDials - 1, o.value));
+      }
+      run.zoomDials = std::pair{x, y};
     } else if (o.name == "--audio") {
       run.audio = true;
     } else if (o.name == "--record") {
@@ -313,6 +333,9 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       return fail(Errc::kInvalidArgument,
                   fmt::format("--zoom {}: no movie of that name; give --movie {}=FILE too", name, name));
     }
+  }
+  if (run.zoomDials && run.zooms.empty()) {
+    return fail(Errc::kInvalidArgument, "--zoom-dials moves the Zoom picture: give --zoom PART too");
   }
   return run;
 }
@@ -602,6 +625,15 @@ int runShow(const RunOptions& options) {
   }
   // Devices: a replayed trace drives the show through LAVA's dial table.
   runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  if (options.zoomDials && videos) {
+    // A full turn moves the Zoom picture across the whole output (LAVA: Shift + drag).
+    const render::Size size = (*output)->size();
+    bindings.setDial(static_cast<std::size_t>(options.zoomDials->first),
+                     {runtime::Action::kMoveZoomX, static_cast<double>(size.width)});
+    bindings.setDial(static_cast<std::size_t>(options.zoomDials->second),
+                     {runtime::Action::kMoveZoomY, static_cast<double>(size.height)});
+    videos->followZoomDials(&bindings);
+  }
   std::unique_ptr<DeviceWiring> devices;
   if (options.replay) {
     devices = std::make_unique<DeviceWiring>(clock, [eventLoop] { eventLoop->wake(); });

@@ -45,6 +45,7 @@ struct RunOptions {
   std::optional<std::filesystem::path> saveModel;                     ///< write the show as .mdl at the end
   std::vector<std::pair<std::string, std::filesystem::path>> movies;  ///< --movie PART=FILE, in order
   std::vector<std::pair<std::string, ZoomSpec>> zooms;                ///< --zoom PART[=SCALE][@X,Y]
+  std::optional<std::pair<int, int>> zoomDials;                       ///< --zoom-dials X,Y
   bool movieOnce = false;                                             ///< --movie-once: no repeat
   bool audio = false;                                                 ///< --audio: movie sound on
   std::optional<std::filesystem::path> record;                        ///< --record PATH

@@ -33,6 +33,9 @@ using script::StepStop;
 
 namespace {
 
+/// The averaged picture of a jitter loop, drawn over the output (not a name parts can use).
+constexpr std::string_view kJitterTexture = "lava:jitter-average";
+
 std::string lowerExtension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -109,6 +112,7 @@ ScriptPlayer::ScriptPlayer(script::Interpreter interpreter, runtime::Show& show,
 
 ScriptPlayer::~ScriptPlayer() {
   if (videoLive_) renderer_.textures().remove(kScriptVideoTexture);
+  if (overlay_) renderer_.textures().remove(kJitterTexture);
 }
 
 void ScriptPlayer::setReporter(const script::Interpreter::Reporter& reporter) {
@@ -215,6 +219,31 @@ Result<void> ScriptPlayer::accumulateJitterPass(int pass, int passes) {
     jitterAverage_.pixels[i] = static_cast<std::uint8_t>((jitterSum_[i] + n / 2) / n);
   }
   jitterReady_ = true;
+  // LAVA showed the accumulated picture: the average replaces the last pass on the output, so
+  // the frame presented after the jitter loop is the antialiased one (and stays until the next
+  // draw). If it cannot be drawn, the last pass shows and save_image still writes the average.
+  if (auto r = presentPicture(jitterAverage_); !r) {
+    return fail(r.error().code(),
+                fmt::format("the averaged picture is not shown ({}); save_image still writes it", r.error().message()));
+  }
+  return {};
+}
+
+Result<void> ScriptPlayer::presentPicture(const Image& image) {
+  if (!overlay_) {
+    auto overlay = render::PictureOverlay::create();
+    if (!overlay) return std::unexpected(overlay.error());
+    overlay_ = std::move(*overlay);
+  }
+  const std::string name(kJitterTexture);
+  if (auto r = renderer_.textures().setImage(name, image); !r) return r;
+  const render::TextureView* view = renderer_.textures().find(name);
+  if (!view) return fail(Errc::kInternal, "the averaged picture's texture is missing");
+  const render::Size size = output_->size();
+  if (size.width != image.width || size.height != image.height) {
+    return fail(Errc::kInternal, "the output changed size during the jitter loop");
+  }
+  overlay_->draw(*view, {0, 0, static_cast<float>(size.width), static_cast<float>(size.height)}, size);
   return {};
 }
 

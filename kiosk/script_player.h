@@ -83,6 +83,7 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
  private:
   void runStep();
   Result<const Image*> currentPicture();
+  Result<void> presentPicture(const Image& image);
   void warn(std::string message);
   Result<void> vcrCommand(const script::TvRequest& request);
   void updateVideo(Nanos showTime, bool manualClock);
@@ -101,7 +102,8 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
   bool frameRead_ = false;
   std::vector<std::uint32_t> jitterSum_;  // per channel, sized on the first pass
   Image jitterAverage_;
-  bool jitterReady_ = false;  // jitterAverage_ is the current picture (until the next draw)
+  bool jitterReady_ = false;                         // jitterAverage_ is the current picture (until the next draw)
+  std::unique_ptr<render::PictureOverlay> overlay_;  // puts the jitter average on the output
   std::vector<std::filesystem::path> written_;
   // The VCR (LAVA §7): one movie player and the live camera, shown as kScriptVideoTexture.
   std::unique_ptr<media::MoviePlayer> vcr_;

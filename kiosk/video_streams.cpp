@@ -114,6 +114,13 @@ Result<std::unique_ptr<VideoStreams>> VideoStreams::create(const std::vector<Mov
 }
 
 Result<void> VideoStreams::beforeDraw(const FrameContext& frame) {
+  if (zoomDials_) {
+    // The frame loop applied this frame's input just before: the dials' turns since last frame.
+    const runtime::Bindings::ZoomMove move = zoomDials_->takeZoomMove();
+    if (move.dx != 0 || move.dy != 0) {
+      for (const auto& s : streams_) moveZoom(s->spec.name, move.dx, move.dy);
+    }
+  }
   for (const auto& s : streams_) {
     media::MoviePlayer& player = *s->player;
     if (manualClock_) player.waitForFrameDue(frame.time, std::chrono::seconds(10));
@@ -170,6 +177,15 @@ void VideoStreams::moveZoom(std::string_view name, float dx, float dy) {
     s->zoomRect.x += dx;
     s->zoomRect.y += dy;
   }
+}
+
+std::optional<render::PictureRect> VideoStreams::zoomRect(std::string_view name) const {
+  for (const auto& s : streams_) {
+    if (s->spec.name != name || !s->spec.zoom) continue;
+    if (s->zoomPlaced) return s->zoomRect;
+    return render::PictureRect{s->spec.zoom->x, s->spec.zoom->y, 0, 0};
+  }
+  return std::nullopt;
 }
 
 std::vector<std::string> VideoStreams::status() const {

@@ -19,6 +19,7 @@
 #include "media/recorder.h"
 #include "render/renderer.h"
 #include "render/stream_texture.h"
+#include "runtime/bindings.h"
 #include "runtime/error.h"
 #include "runtime/show/show.h"
 
@@ -66,6 +67,12 @@ class VideoStreams final : public FrameParticipant {
   [[nodiscard]] media::MoviePlayer* player(std::string_view name);
   /// \brief Moves stream `name`'s Zoom picture by (dx, dy) pixels (LAVA: Shift + drag).
   void moveZoom(std::string_view name, float dx, float dy);
+  /// \brief Lets dials move the Zoom pictures: before each frame, what the `move_zoom_x` and
+  /// `move_zoom_y` dials of `bindings` turned (runtime::Bindings::takeZoomMove) moves every Zoom
+  /// picture. `bindings` must outlive this; null stops following.
+  void followZoomDials(runtime::Bindings* bindings) { zoomDials_ = bindings; }
+  /// \brief Where stream `name`'s Zoom picture is now (output pixels), or nullopt.
+  [[nodiscard]] std::optional<render::PictureRect> zoomRect(std::string_view name) const;
   /// \brief One line per stream: file, state, frame, upload path.
   [[nodiscard]] std::vector<std::string> status() const;
 
@@ -76,6 +83,7 @@ class VideoStreams final : public FrameParticipant {
   bool manualClock_;
   std::vector<std::unique_ptr<Stream>> streams_;
   std::unique_ptr<render::PictureOverlay> overlay_;
+  runtime::Bindings* zoomDials_ = nullptr;
 };
 
 /// \brief Records the rendered output (LAVA's Rec): reads each frame back after drawing and

@@ -92,11 +92,12 @@ struct Clip {
   std::string name;
 
   std::mutex mutex;
-  bool videoLinked = false;  // guarded by mutex
-  bool noMorePads = false;   // guarded by mutex
-  bool hasAudio = false;     // guarded by mutex
-  std::string codec;         // guarded by mutex
-  std::string unsupported;   // guarded by mutex: a video codec Basalt does not play
+  bool videoLinked = false;       // guarded by mutex
+  bool noMorePads = false;        // guarded by mutex
+  bool hasAudio = false;          // guarded by mutex
+  bool audioUnavailable = false;  // guarded by mutex: sound asked for, no audio output here
+  std::string codec;              // guarded by mutex
+  std::string unsupported;        // guarded by mutex: a video codec Basalt does not play
 
   // Decoder thread only:
   bool prerolled = false;
@@ -107,6 +108,44 @@ struct Clip {
 };
 
 namespace {
+
+/// The audio sink this machine can open (its factory name), or empty where it has none (no
+/// sound device, no sound server). Probed once per process, as autoaudiosink chooses: by rank,
+/// the first sink that reaches READY. autoaudiosink itself falls back to a fake sink without a
+/// word, so a show would play silently and nobody would know why.
+const std::string& usableAudioSink() {
+  static const std::string found = [] {
+    GList* factories = gst_element_factory_list_get_elements(
+        GST_ELEMENT_FACTORY_TYPE_SINK | GST_ELEMENT_FACTORY_TYPE_MEDIA_AUDIO, GST_RANK_MARGINAL);
+    factories = g_list_sort(factories, reinterpret_cast<GCompareFunc>(gst_plugin_feature_rank_compare_func));
+    std::string name;
+    for (GList* l = factories; l && name.empty(); l = l->next) {
+      auto* factory = static_cast<GstElementFactory*>(l->data);
+      GstElement* sink = gst_element_factory_create(factory, nullptr);
+      if (!sink) continue;
+      gst_object_ref_sink(sink);
+      if (gst_element_set_state(sink, GST_STATE_READY) == GST_STATE_CHANGE_SUCCESS) {
+        name = gst_plugin_feature_get_name(GST_PLUGIN_FEATURE(factory));
+      }
+      gst_element_set_state(sink, GST_STATE_NULL);
+      gst_object_unref(sink);
+    }
+    gst_plugin_feature_list_free(factories);
+    return name;
+  }();
+  return found;
+}
+
+/// Says once per process that sound is asked for but the machine cannot play it.
+void noteNoAudioSink(const std::string& player, const std::filesystem::path& file) {
+  static log::Once once;
+  if (once.first()) {
+    log::warn(kLogMedia,
+              "{}: {}: sound is on (--audio) but this machine has no audio output (no sound device or sound "
+              "server reachable); movies play without sound",
+              player, file.string());
+  }
+}
 
 void onPadAdded(GstElement*, GstPad* pad, gpointer data) {
   auto* clip = static_cast<Clip*>(data);
@@ -129,8 +168,9 @@ void onPadAdded(GstElement*, GstPad* pad, gpointer data) {
   }
   // Everything else (sound, subtitles, data, extra video tracks) ends in a sink that never waits.
   GstElement* tail = nullptr;
-  if (name == "audio/x-raw" && clip->audio) {
-    tail = gst_parse_bin_from_description("queue ! audioconvert ! audioresample ! autoaudiosink", TRUE, nullptr);
+  if (name == "audio/x-raw" && clip->audio && !usableAudioSink().empty()) {
+    const std::string description = fmt::format("queue ! audioconvert ! audioresample ! {}", usableAudioSink());
+    tail = gst_parse_bin_from_description(description.c_str(), TRUE, nullptr);
   }
   if (!tail) {
     tail = gst_element_factory_make("fakesink", nullptr);
@@ -150,7 +190,7 @@ void onNoMorePads(GstElement*, gpointer data) {
 }
 
 /// Decodes only what Basalt plays: unsupported video stays encoded (and is reported), and
-/// sound is not decoded at all when the player discards it.
+/// sound is not decoded at all when the player discards it or the machine cannot play it.
 gboolean onAutoplugContinue(GstElement*, GstPad*, GstCaps* caps, gpointer data) {
   auto* clip = static_cast<Clip*>(data);
   if (gst_caps_get_size(caps) == 0) return TRUE;
@@ -159,7 +199,11 @@ gboolean onAutoplugContinue(GstElement*, GstPad*, GstCaps* caps, gpointer data) 
   if (name.starts_with("audio/")) {
     std::lock_guard lock(clip->mutex);
     clip->hasAudio = true;
-    return clip->audio ? TRUE : FALSE;
+    if (clip->audio && usableAudioSink().empty()) {
+      clip->audioUnavailable = true;
+      noteNoAudioSink(clip->name, clip->path);
+    }
+    return clip->audio && !clip->audioUnavailable ? TRUE : FALSE;
   }
   if (isVideoCaps(s) && name != "video/x-raw") {
     std::lock_guard lock(clip->mutex);
@@ -411,11 +455,16 @@ Result<void> MoviePlayer::Impl::finishOpen(Clip& clip, std::chrono::milliseconds
     std::lock_guard lock(clip.mutex);
     mi.codec = clip.codec;
     mi.hasAudio = clip.hasAudio;
+    mi.audioOutputMissing = clip.audioUnavailable;
   }
   clip.prerolled = true;
   log::info(kLogMedia, "{}: {} {}x{} {:.3f} fps {} ({}), {} frames{}; upload path: {} planes + shader", clip.name,
             clip.path.filename(), mi.width, mi.height, mi.fps, mi.codec, pixelFormatName(mi.format), mi.frameCount,
-            mi.hasAudio ? (options.audio ? ", sound on" : ", sound discarded") : "", pixelFormatName(mi.format));
+            !mi.hasAudio            ? ""
+            : mi.audioOutputMissing ? ", sound discarded (no audio output here)"
+            : options.audio         ? ", sound on"
+                                    : ", sound discarded",
+            pixelFormatName(mi.format));
   return {};
 }
 

@@ -37,6 +37,9 @@ struct MovieInfo {
   Colorimetry colorimetry{};
   std::string codec;  ///< e.g. "H.264 (High Profile)"
   bool hasAudio = false;
+  /// Sound was asked for (MoviePlayerOptions::audio) and the movie has some, but this machine
+  /// has no audio output: the movie plays without sound (said once per process in the log).
+  bool audioOutputMissing = false;
   bool seekable = false;
 };
 

@@ -128,7 +128,7 @@ void setSampling(GLenum filter) {
 /// The conversion program for one layout.
 struct ConversionProgram {
   gl::Program program;
-  GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1;
+  GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1, chromaScale = -1;
 };
 
 /// yuv.frag with LAYOUT defined: one program per layout, so no pixel runs a branch.
@@ -148,6 +148,7 @@ Result<ConversionProgram> buildConversion(int layout) {
   c.bias = glGetUniformLocation(p, "uBias");
   c.rect = glGetUniformLocation(p, "uRect");
   c.flip = glGetUniformLocation(p, "uFlipY");
+  c.chromaScale = glGetUniformLocation(p, "uChromaScale");
   glUseProgram(p);
   glUniform1i(glGetUniformLocation(p, "uPlane0"), 0);
   glUniform1i(glGetUniformLocation(p, "uPlane1"), 1);
@@ -274,8 +275,9 @@ Result<void> StreamTexture::uploadPlanes(const Frame& frame) {
       g.planes[idx] = gl::Texture::create();
       glBindTexture(GL_TEXTURE_2D, g.planes[idx].id());
       glTexStorage2D(GL_TEXTURE_2D, 1, pf.internal, static_cast<GLsizei>(pf.width), static_cast<GLsizei>(pf.height));
-      // Packed 4:2:2 is read texel by texel; planes are filtered (chroma upsampling).
-      setSampling(frame.format == PixelFormat::kYuyv || frame.format == PixelFormat::kUyvy ? GL_NEAREST : GL_LINEAR);
+      // Sampled at texel centres, texel by texel (the shader sites chroma with its top-left
+      // luma sample); nearest keeps a software renderer's sampling to a plain load.
+      setSampling(GL_NEAREST);
       g.planeFormat[idx] = pf;
     } else {
       glBindTexture(GL_TEXTURE_2D, g.planes[idx].id());
@@ -388,6 +390,11 @@ Result<void> StreamTexture::convert(const Frame& frame) {
               -(m[2] * offset[0] + m[5] * offset[1] + m[8] * offset[2]));
   glUniform4f(c.rect, -1.0f, -1.0f, 1.0f, 1.0f);
   glUniform1i(c.flip, 0);
+  if (c.chromaScale >= 0) {
+    const std::uint32_t cw = (frame.width + 1) / 2, ch = (frame.height + 1) / 2;
+    glUniform2f(c.chromaScale, static_cast<float>(frame.width) / static_cast<float>(2 * cw),
+                static_cast<float>(frame.height) / static_cast<float>(2 * ch));
+  }
   // YV12 stores V before U: bind the planes so that unit 1 is always U.
   const bool swapUv = frame.format == PixelFormat::kYv12;
   for (int i = 0; i < 3; ++i) {

@@ -18,6 +18,8 @@ constexpr struct {
     {Action::kTranslateX, "translate_x"},
     {Action::kTranslateY, "translate_y"},
     {Action::kTranslateZ, "translate_z"},
+    {Action::kMoveZoomX, "move_zoom_x"},
+    {Action::kMoveZoomY, "move_zoom_y"},
 };
 
 // Turns further apart than this count as a fresh, slow turn for acceleration.
@@ -60,7 +62,10 @@ void Bindings::setAcceleration(double acceleration) {
   for (DialBinding& d : dials_) d.acceleration = acceleration;
 }
 
-void Bindings::reset() { state_.fill(DialState{}); }
+void Bindings::reset() {
+  state_.fill(DialState{});
+  zoomMove_ = {};
+}
 
 bool Bindings::turn(std::size_t dial, double turns, Nanos time, Show& show, bool accelerate) {
   const DialBinding& b = dials_[dial];
@@ -84,6 +89,8 @@ bool Bindings::turn(std::size_t dial, double turns, Nanos time, Show& show, bool
     case Action::kTranslateX: show.translateGlobal({amount, 0, 0}); return true;
     case Action::kTranslateY: show.translateGlobal({0, amount, 0}); return true;
     case Action::kTranslateZ: show.translateGlobal({0, 0, amount}); return true;
+    case Action::kMoveZoomX: zoomMove_.dx += amount; return true;
+    case Action::kMoveZoomY: zoomMove_.dy += amount; return true;
   }
   return false;
 }

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 #include <string_view>
+#include <utility>
 
 #include "runtime/clock.h"
 #include "runtime/event.h"
@@ -17,7 +18,21 @@
 
 namespace basalt::runtime {
 
-enum class Action : std::uint8_t { kNone, kRotateX, kRotateY, kRotateZ, kScale, kTranslateX, kTranslateY, kTranslateZ };
+/// The move_zoom actions move LAVA's Zoom picture (a movie drawn flat over the scene, LAVA §4.3
+/// "Shift + drag") by `gain` output pixels per turn; they leave the Show alone and are collected
+/// for the movie streams (Bindings::takeZoomMove()).
+enum class Action : std::uint8_t {
+  kNone,
+  kRotateX,
+  kRotateY,
+  kRotateZ,
+  kScale,
+  kTranslateX,
+  kTranslateY,
+  kTranslateZ,
+  kMoveZoomX,
+  kMoveZoomY,
+};
 
 /// \brief "rotate_x", "scale", "none", ... (the names a show manifest uses).
 std::string_view actionName(Action action);
@@ -68,6 +83,14 @@ class Bindings {
   /// \brief Forgets speeds, positions and shuttles (a new show, a replay from the start).
   void reset();
 
+  /// \brief Output pixels the move_zoom dials turned since the last call (right and down are
+  /// positive), and zero from then on.
+  struct ZoomMove {
+    float dx = 0;
+    float dy = 0;
+  };
+  [[nodiscard]] ZoomMove takeZoomMove() { return std::exchange(zoomMove_, ZoomMove{}); }
+
  private:
   bool turn(std::size_t dial, double turns, Nanos time, Show& show, bool accelerate);
 
@@ -83,6 +106,7 @@ class Bindings {
   std::array<DialState, kMaxBoundDials> state_{};
   double gain_ = 1;
   double shuttleRate_ = 1;
+  ZoomMove zoomMove_;
 };
 
 }  // namespace basalt::runtime

@@ -247,7 +247,9 @@ void Interpreter::execute(const Instr& in, Show& show, Host& host) {
         report(in, Severity::kError, fmt::format("load_object: {}", r.error().describe()));
         break;
       }
-      object_ = {false, text(in)};
+      object_ = {false, text(in), {}};
+      object_.textures.reserve(show.partCount());
+      for (PartId id = 0; id < show.partCount(); ++id) object_.textures.push_back(show.part(id).texture);
       break;
     }
     case Action::kLoadColorCube:

@@ -46,6 +46,10 @@ struct StepResult {
 struct ObjectSource {
   bool colorCube = true;  ///< LAVA's colour cube (start-up, or load_color_cube)
   std::string file;       ///< otherwise the file given to load_object, as the script named it
+  /// Per part (by PartId), the texture the object's own materials gave it when it was loaded:
+  /// loading the object again gives it again, so Save Model leaves these to the model (a
+  /// material's texture is named by its resolved path, which a script may not name).
+  std::vector<std::string> textures;
 };
 
 /// \brief LAVA's start-up state as a script finds it: the colour cube, turned to show three

@@ -55,9 +55,15 @@ std::string saveModel(const Show& original, const ObjectSource& object) {
   }
 
   // Textures go on the displayed parts, so display exactly the parts of each texture in turn.
+  // A part showing the texture its object's materials gave it gets it again from load_object:
+  // that one is left to the model (its name is the material's resolved path, which a script
+  // may not name: absolute, or relative to the model's folder rather than the script's).
   std::map<std::string, std::vector<PartId>> textured;
   for (PartId id = 0; id < show.partCount(); ++id) {
-    if (!show.part(id).texture.empty()) textured[show.part(id).texture].push_back(id);
+    const std::string& texture = show.part(id).texture;
+    if (texture.empty()) continue;
+    if (!object.colorCube && id < object.textures.size() && object.textures[id] == texture) continue;
+    textured[texture].push_back(id);
   }
   if (!textured.empty()) {
     line(out, "");

@@ -269,14 +269,21 @@ BENCHMARK(glimagesinkPeer)->UseManualTime()->Unit(benchmark::kMillisecond)->Iter
 BENCHMARK(naiveRgbaUpload)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3);
 BENCHMARK(basaltPlayer)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3);
 
+/// Says why a stream count could not be measured; returns -1.
+std::int64_t failed(const std::string& why) {
+  std::printf("  (cannot measure: %s)\n", why.c_str());
+  return -1;
+}
+
 /// Plays `count` streams of `file` at 30 fps on the system clock for `seconds`, each through a
 /// stream texture drawn as a quad; returns the frames dropped (shown frame numbers that skip or
 /// repeat after the first half second).
 std::int64_t droppedWithStreams(const std::filesystem::path& file, int count, double seconds) {
   using namespace basalt;
   auto output = render::createHeadlessOutput({1280, 720});
+  if (!output) return failed(output.error().describe());
   auto overlay = render::PictureOverlay::create();
-  if (!output || !overlay) return -1;
+  if (!overlay) return failed(overlay.error().describe());
   std::vector<std::unique_ptr<media::MoviePlayer>> players;
   std::vector<std::unique_ptr<render::StreamTexture>> streams;
   for (int i = 0; i < count; ++i) {
@@ -284,7 +291,9 @@ std::int64_t droppedWithStreams(const std::filesystem::path& file, int count, do
     o.queueFrames = 8;
     auto p = media::MoviePlayer::create(o);
     auto s = render::StreamTexture::create("s" + std::to_string(i));
-    if (!p || !s || !(*p)->load(file) || !(*p)->waitUntilLoaded(std::chrono::seconds(30))) return -1;
+    if (!p || !s) return failed("cannot make a player or a stream texture");
+    if (!(*p)->load(file)) return failed("cannot load " + file.string());
+    if (auto info = (*p)->waitUntilLoaded(std::chrono::seconds(30)); !info) return failed(info.error().describe());
     (*p)->setRepeat(true);
     players.push_back(std::move(*p));
     streams.push_back(std::move(*s));
@@ -301,11 +310,15 @@ std::int64_t droppedWithStreams(const std::filesystem::path& file, int count, do
   for (int n = 0; n < frames; ++n) {
     const Nanos due = frameTime(n, 30);
     while (clock.now() - start < due) std::this_thread::sleep_for(std::chrono::microseconds(500));
-    if (!(*output)->beginFrame()) return -1;
+    // Streams convert into their own textures first (update() leaves framebuffer 0 bound, which
+    // a surfaceless output does not have); then the output's frame draws them.
     for (int i = 0; i < count; ++i) {
       const auto idx = static_cast<std::size_t>(i);
-      const FrameRef f = players[idx]->frameAt(due);
-      if (!streams[idx]->update(f)) return -1;
+      if (auto r = streams[idx]->update(players[idx]->frameAt(due)); !r) return failed(r.error().describe());
+    }
+    if (auto r = (*output)->beginFrame(); !r) return failed(r.error().describe());
+    for (int i = 0; i < count; ++i) {
+      const auto idx = static_cast<std::size_t>(i);
       const float w = 1280.0f / static_cast<float>(count);
       (*overlay)->draw(streams[idx]->view(), {w * static_cast<float>(i), 0, w, 720}, (*output)->size());
       const std::int64_t now = players[idx]->currentFrame();
@@ -315,7 +328,7 @@ std::int64_t droppedWithStreams(const std::filesystem::path& file, int count, do
       }
       last[idx] = now;
     }
-    if (!(*output)->present()) return -1;
+    if (auto r = (*output)->present(); !r) return failed(r.error().describe());
     glFinish();
   }
   return dropped;

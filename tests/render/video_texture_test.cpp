@@ -12,10 +12,12 @@
 #include <memory>
 #include <vector>
 
+#include "kiosk/video_streams.h"
 #include "media/movie_player.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "render/stream_texture.h"
+#include "runtime/bindings.h"
 #include "runtime/show/show.h"
 #include "support/numbered_clip.h"
 #include "support/test_paths.h"
@@ -141,6 +143,59 @@ TEST_F(VideoTextures, ZoomPictureSitsWhereItIsPutAndMoves) {
   const Image b = drawAt({150, 110, 160, 120});
   EXPECT_EQ(test::readImageNumber(b, 150, 110, 160, 120), 21);
   EXPECT_NE(test::readImageNumber(b, 10, 20, 80, 60), 21) << "the picture left its old place";
+}
+
+TEST_F(VideoTextures, ZoomDialsMoveTheZoomPictureOfAShow) {
+  // The Zoom picture moved by dials, the way `basalt run --zoom PART --zoom-dials 6,7 --replay`
+  // wires it: the dials' turns go through the show's Bindings (move_zoom_x/y) to VideoStreams,
+  // which draws the picture at its new place on the next frame.
+  // Failure caught: moveZoom with nothing calling it; dials that turn the object instead.
+  const auto file = clip("zoom-dials-40.mkv", 30, 30, media::VideoCodec::kH264, 40);
+  auto renderer = Renderer::create();
+  ASSERT_TRUE(renderer);
+  runtime::Show show = runtime::Show::makeDefault();
+  kiosk::MovieStreamSpec spec;
+  spec.name = "movie";
+  spec.files = {file};
+  spec.zoom = kiosk::ZoomSpec{0.5, 10, 20};
+  auto streams = kiosk::VideoStreams::create({spec}, show, **renderer, true);
+  ASSERT_TRUE(streams) << streams.error().describe();
+  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  bindings.setDial(6, {runtime::Action::kMoveZoomX, 320});
+  bindings.setDial(7, {runtime::Action::kMoveZoomY, 240});
+  (*streams)->followZoomDials(&bindings);
+  std::int64_t frame = 0;
+  auto drawFrame = [&] {
+    kiosk::FrameContext context;
+    context.frame = frame;
+    context.time = Nanos{0};  // the movie's first frame, on every frame of this test
+    ++frame;
+    Image out;
+    EXPECT_TRUE((*streams)->beforeDraw(context));
+    EXPECT_TRUE(output_->beginFrame());
+    (*renderer)->draw(show, runtime::computeView(show, 320.0f / 240.0f), output_->size());
+    EXPECT_TRUE((*streams)->afterDraw(context, *output_));
+    EXPECT_TRUE(output_->readBack(out));
+    return out;
+  };
+  const Image a = drawFrame();
+  EXPECT_EQ(test::readImageNumber(a, 10, 20, 80, 60), 40) << "half size at (10, 20)";
+  const Mat4 object = show.position().global;
+  // Half a turn on each dial: half the output across and down.
+  EXPECT_TRUE(bindings.apply(Event{Nanos{0}, 1, EventKind::kDialDelta, 6, 0.5}, show));
+  EXPECT_TRUE(bindings.apply(Event{Nanos{0}, 1, EventKind::kDialDelta, 7, 0.25}, show));
+  EXPECT_TRUE(bindings.apply(Event{Nanos{0}, 1, EventKind::kDialDelta, 7, 0.25}, show));
+  const Image b = drawFrame();
+  const auto rect = (*streams)->zoomRect("movie");
+  ASSERT_TRUE(rect.has_value());
+  EXPECT_FLOAT_EQ(rect->x, 170.0f);
+  EXPECT_FLOAT_EQ(rect->y, 140.0f);
+  EXPECT_EQ(test::readImageNumber(b, 170, 140, 80, 60), 40) << "the picture is at its new place";
+  EXPECT_NE(test::readImageNumber(b, 10, 20, 80, 60), 40) << "and left the old one";
+  EXPECT_EQ(show.position().global.m, object.m) << "the zoom dials did not turn the object";
+  // No more turns: it stays.
+  const Image c = drawFrame();
+  EXPECT_EQ(test::readImageNumber(c, 170, 140, 80, 60), 40);
 }
 
 }  // namespace

@@ -35,7 +35,10 @@ class Pictures : public ::testing::Test {
   std::filesystem::path dir_;
 };
 
-TEST_F(Pictures, JitterAveragesItsPassesAndSaveImageWritesThem) {
+TEST_F(Pictures, JitterAveragesItsPassesShowsAndSavesTheAverage) {
+  // The frame presented at the end of the jitter loop is the average (LAVA showed the
+  // accumulated picture), and save_image writes that average.
+  // Failure caught: the average only written to files while the screen shows the last pass.
   const auto script = writeScript("jitter", R"(position.global_y_rotate = 10
 jitter 8
   draw
@@ -47,27 +50,39 @@ save_image
 quit
 )");
   kiosk::ScriptPlayerOptions options;
-  options.outputDir = dir_ / "out";
+  const auto outDir = dir_ / "out";
+  options.outputDir = outDir;
   const auto played = stage_->play(script, 100, {}, {0, 1, 2, 3, 4, 5, 6, 7, 8}, options);
   ASSERT_EQ(played.stats.frames, 9);
   ASSERT_EQ(played.imagesWritten.size(), 3u);
+  // The raw passes: the offsets of pass i do not depend on the pass count, so a loop of nine
+  // shows the eight passes above unaveraged as its frames 0 to 7.
+  const auto nine = writeScript("jitter9", "position.global_y_rotate = 10\njitter 9\n  draw\nend_jitter\nquit\n");
+  const auto passes = stage_->play(nine, 100, {}, {0, 1, 2, 3, 4, 5, 6, 7}, options);
+  ASSERT_EQ(passes.stats.frames, 9);
+  for (std::int64_t f = 0; f < 7; ++f) {
+    EXPECT_TRUE(passes.at(f).image.pixels == played.at(f).image.pixels) << "pass " << f << " is the same in both";
+  }
 
   // The passes differ: each is drawn with its own sub-pixel offset.
   EXPECT_FALSE(played.at(0).image.pixels == played.at(1).image.pixels);
   // avg.png is the rounded mean of the eight passes, exactly.
-  auto average = media::readImage(dir_ / "out/avg.png");
+  auto average = media::readImage(outDir / "avg.png");
   ASSERT_TRUE(average) << average.error().describe();
   const Image& first = played.at(0).image;
   ASSERT_EQ(average->pixels.size(), first.pixels.size());
   std::size_t mismatches = 0;
   for (std::size_t i = 0; i < first.pixels.size(); ++i) {
     unsigned sum = 0;
-    for (std::int64_t f = 0; f < 8; ++f) sum += played.at(f).image.pixels[i];
+    for (std::int64_t f = 0; f < 8; ++f) sum += passes.at(f).image.pixels[i];
     mismatches += average->pixels[i] == (sum + 4) / 8 ? 0u : 1u;
   }
   EXPECT_EQ(mismatches, 0u);
+  // The frame shown after the loop (frame 7, the last pass's) is the average, bit for bit.
+  EXPECT_TRUE(played.at(7).image.pixels == average->pixels) << "the screen shows the last pass, not the average";
+  EXPECT_FALSE(played.at(7).image.pixels == passes.at(7).image.pixels);
   // single.png is the frame drawn after the loop, not a later one.
-  auto single = media::readImage(dir_ / "out/single.png");
+  auto single = media::readImage(outDir / "single.png");
   ASSERT_TRUE(single);
   EXPECT_TRUE(single->pixels == played.at(8).image.pixels);
   // The averaged edges are soft: values between the object's and the background's.
@@ -78,7 +93,7 @@ quit
   // A bare save_image: LAVA's ras.im32, a Sun rasterfile in the output folder, holding the
   // frame drawn last (the single pass).
   const auto& last = played.imagesWritten.back();
-  EXPECT_EQ(last, dir_ / "out" / "ras.im32");
+  EXPECT_EQ(last, outDir / "ras.im32");
   std::ifstream raster(last, std::ios::binary);
   unsigned char magic[4] = {};
   raster.read(reinterpret_cast<char*>(magic), 4);
@@ -126,6 +141,60 @@ TEST_F(Pictures, SaveModelGivesTheSamePictureBitForBit) {
     }
     EXPECT_TRUE(stage_->render(original.show).pixels == stage_->render(restored.show).pixels) << name << " + 30 frames";
   }
+}
+
+TEST_F(Pictures, SaveModelOfATexturedModelReloadsToTheSamePicture) {
+  // A model whose materials carry textures (assimp's spider, five JPEG maps named as
+  // ".\\File.jpg" in its MTL), plus one texture the script maps itself. Saved next to the script
+  // and played from there, the model gives the same picture bit for bit: the material textures
+  // come back with the model (Save Model leaves them to it, rather than writing their resolved
+  // paths, which a script may not name), the script's own texture by its own name.
+  // Failure caught: `load_texture "/abs/path/SpiderTex.jpg"` in the saved model (refused on
+  // reload), or a texture resolved twice (model folder + script folder).
+  const auto source = basalt::test::testdataDir() / "models/obj/assimp";
+  if (!std::filesystem::exists(source / "spider.obj")) GTEST_SKIP() << "no shared test data at " << source;
+  const auto script = writeScript("spider", R"(load_object "spider.obj"
+position.global_y_rotate = 30
+position.global_x_rotate = 20
+part.deselect_all
+part.select "Auge"
+load_texture "eye.jpg"
+part.select_all
+draw
+quit
+)");
+  for (const char* file : {"spider.obj", "spider.mtl", "SpiderTex.jpg", "drkwood2.jpg", "engineflare1.jpg",
+                           "wal67ar_small.jpg", "wal69ar_small.jpg"}) {
+    std::filesystem::copy_file(source / file, dir_ / file);
+  }
+  std::filesystem::copy_file(source / "engineflare1.jpg", dir_ / "eye.jpg");
+  const auto played = stage_->play(script, 10, {0}, {0});
+  ASSERT_EQ(played.count(Severity::kError), 0u) << "the model and its textures load";
+  ASSERT_EQ(played.stats.frames, 1);
+  const runtime::Show& shown = played.at(0).show;
+  std::size_t textured = 0;
+  for (runtime::PartId id = 0; id < shown.partCount(); ++id) textured += shown.part(id).texture.empty() ? 0u : 1u;
+  ASSERT_GE(textured, 2u) << "the spider's parts carry their material textures";
+
+  const std::string saved = saveModel(played.finalShow, played.object);
+  EXPECT_EQ(saved.find(dir_.string()), std::string::npos) << "no absolute path in the saved model:\n" << saved;
+  EXPECT_NE(saved.find("load_texture \"eye.jpg\""), std::string::npos) << "the script's own texture is kept";
+  const auto savedScript = dir_ / "saved.mdl";
+  std::ofstream(savedScript) << saved << "draw\nquit\n";
+
+  // The registry forgets the first run's textures, so the reload must bring them itself.
+  for (runtime::PartId id = 0; id < shown.partCount(); ++id) {
+    if (!shown.part(id).texture.empty()) stage_->renderer().textures().remove(shown.part(id).texture);
+  }
+  const auto reloaded = stage_->play(savedScript, 10, {0}, {0});
+  EXPECT_EQ(reloaded.count(Severity::kError), 0u) << "the saved model plays without errors";
+  EXPECT_EQ(reloaded.count(Severity::kWarning), 0u) << "... and without warnings";
+  ASSERT_EQ(reloaded.stats.frames, 1);
+  for (runtime::PartId id = 0; id < shown.partCount(); ++id) {
+    EXPECT_EQ(reloaded.at(0).show.part(id).texture, shown.part(id).texture) << shown.part(id).name;
+  }
+  EXPECT_GT(test::coverage(played.at(0).image), 0.01) << "nothing drawn";
+  EXPECT_TRUE(played.at(0).image.pixels == reloaded.at(0).image.pixels) << "the reloaded model looks different";
 }
 
 TEST_F(Pictures, LoadObjectShowsAModelWithItsMaterials) {

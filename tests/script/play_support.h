@@ -57,6 +57,7 @@ class Stage {
   Image render(const runtime::Show& show);
 
   render::Output& output() { return *output_; }
+  render::Renderer& renderer() { return *renderer_; }
 
  private:
   std::unique_ptr<render::Output> output_;

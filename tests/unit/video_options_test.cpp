@@ -69,5 +69,27 @@ TEST(VideoOptions, ZoomWithoutItsMovieAndUnknownCodecsAreErrors) {
   EXPECT_NE(c.error().message().find("h264, mjpeg, vp8, vp9"), std::string::npos);
 }
 
+// --zoom-dials X,Y: the two dials that move the Zoom picture. Failure caught: one dial for both
+// directions, a dial number past the bindings' table, dials given with no Zoom picture to move.
+TEST(VideoOptions, ZoomDialsNameTwoDialsAndNeedAZoom) {
+  const std::vector<std::string_view> ok = {"--movie", "a=1.mp4", "--zoom", "a", "--zoom-dials", "6,7"};
+  auto o = parseRunOptions(ok);
+  ASSERT_TRUE(o) << o.error().describe();
+  ASSERT_TRUE(o->zoomDials.has_value());
+  EXPECT_EQ(o->zoomDials->first, 6);
+  EXPECT_EQ(o->zoomDials->second, 7);
+  for (std::string_view bad : {"6", "6,6", "6,x", "-1,2", "6,32", "6,7,8"}) {
+    const std::vector<std::string_view> args = {"--movie", "a=1.mp4", "--zoom", "a", "--zoom-dials", bad};
+    auto r = parseRunOptions(args);
+    ASSERT_FALSE(r) << bad;
+    EXPECT_NE(r.error().message().find("--zoom-dials needs two different dial numbers"), std::string::npos)
+        << r.error().message();
+  }
+  const std::vector<std::string_view> noZoom = {"--movie", "a=1.mp4", "--zoom-dials", "6,7"};
+  auto n = parseRunOptions(noZoom);
+  ASSERT_FALSE(n);
+  EXPECT_NE(n.error().message().find("give --zoom PART too"), std::string::npos) << n.error().message();
+}
+
 }  // namespace
 }  // namespace basalt::kiosk
