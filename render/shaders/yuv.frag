@@ -24,6 +24,8 @@ uniform vec3 uYCoef;
 uniform vec3 uUCoef;
 uniform vec3 uVCoef;
 uniform vec3 uBias;
+// 0, or the frame's width to mirror it left-right (a camera that cannot flip in the device).
+uniform int uMirrorWidth;
 
 in vec2 vUv;
 out vec4 fragColor;
@@ -34,6 +36,7 @@ void main() {
   // The target has the frame's size: every sample is a texel fetch (no filtering), chroma at
   // half resolution: 4:2:0 chroma sited with its top-left luma sample.
   ivec2 px = ivec2(gl_FragCoord.xy);
+  if (uMirrorWidth > 0) px.x = uMirrorWidth - 1 - px.x;
   ivec2 cx = px >> 1;  // a shift: software renderers cannot vectorise integer division
 #if LAYOUT == LAYOUT_RGBA
   fragColor = vec4(texelFetch(uPlane0, px, 0).rgb, 1.0);
