@@ -584,8 +584,9 @@ class Reader {
   }
 
   /// A path in the manifest: resolved, confined, and checked to exist.
+  /// `wantFolder`: true a folder, false a regular file, nullopt either.
   std::optional<std::filesystem::path> filePath(const toml::node& node, std::string_view text, std::string_view what,
-                                                bool wantFolder = false) {
+                                                std::optional<bool> wantFolder = false) {
     auto resolved = confinePath(folder_, text);
     if (!resolved) {
       error(lineOf(node), fmt::format("{}: {}", what, resolved.error().message()));
@@ -597,11 +598,11 @@ class Reader {
       error(lineOf(node), fmt::format("{}: '{}' does not exist (looked for {})", what, text, resolved->string()));
       return std::nullopt;
     }
-    if (wantFolder && !std::filesystem::is_directory(status)) {
+    if (wantFolder == true && !std::filesystem::is_directory(status)) {
       error(lineOf(node), fmt::format("{}: '{}' must be a folder", what, text));
       return std::nullopt;
     }
-    if (!wantFolder && !std::filesystem::is_regular_file(status)) {
+    if (wantFolder == false && !std::filesystem::is_regular_file(status)) {
       error(lineOf(node), fmt::format("{}: '{}' is not a regular file", what, text));
       return std::nullopt;
     }
@@ -833,11 +834,11 @@ class Reader {
       if (kind) d.kind = *kind;
       const auto backend = choice<DeviceBackend>(*t, "backend", path,
                                                  {{"hid", DeviceBackend::kHid},
+                                                  {"serial", DeviceBackend::kSerial},
                                                   {"v4l2", DeviceBackend::kV4l2},
                                                   {"libcamera", DeviceBackend::kLibcamera},
                                                   {"replay", DeviceBackend::kReplay},
-                                                  {"synthetic", DeviceBackend::kSynthetic},
-                                                  {"serial", DeviceBackend::kSerial}});
+                                                  {"synthetic", DeviceBackend::kSynthetic}});
       if (!t->get("backend")) {
         error(d.line, fmt::format("{}: needs backend = \"hid\", \"serial\", \"v4l2\", \"libcamera\", \"replay\" "
                                   "or \"synthetic\"",
@@ -864,7 +865,7 @@ class Reader {
         if (const auto* s = trace->as_string()) {
           // A NAME.trace folder from 'basalt record', or (dial boxes) a file from hid-tools'
           // hid-recorder, recorded on any machine.
-          if (auto p = filePath(*trace, s->get(), path + ".trace")) {
+          if (auto p = filePath(*trace, s->get(), path + ".trace", std::nullopt)) {
             std::error_code ec;
             if (std::filesystem::is_regular_file(*p, ec)) {
               if (d.kind == DeviceKind::kCamera) {

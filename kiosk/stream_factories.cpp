@@ -3,6 +3,7 @@
 #include "kiosk/script_player.h"
 #include "kiosk/trace_video_glue.h"
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 
@@ -17,6 +18,7 @@
 #include "render/stream_texture.h"
 #include "runtime/log.h"
 #include "runtime/test_pattern.h"
+#include "sim/hid_recording.h"
 #include "sim/providers.h"
 
 namespace basalt::kiosk {
@@ -239,12 +241,13 @@ class CameraStream final : public TextureStream {
     texture_->setMirror(stream_->mirrorInRenderer());
     const FrameRef frame = stream_->frameAt(showTime);
     if (stream_->health().state != SourceState::kLive) return showLoss(textures);
-    showingLoss_ = false;
     auto changed = texture_->update(frame);
     if (!changed) {
       log::warn(kLogStreams, "camera '{}': {}", media_, changed.error().describe());
       return false;
     }
+    if (*changed) showingLoss_ = false;
+    if (showingLoss_) return true;  // the loss picture stays until the camera's first new frame
     if (texture_->showingFallback()) return false;
     texture_->publish(textures);
     return true;
@@ -381,6 +384,18 @@ Result<std::unique_ptr<devices::DialBox>> makeDialBoxFromSpec(const DeviceSpec& 
   request.kind = devices::DeviceKind::kDialBox;
   request.match = deviceMatchFor(spec);
   request.options["loop"] = spec.loop ? "true" : "false";
+  std::error_code ec;
+  if (spec.backend == DeviceBackend::kReplay && std::filesystem::is_regular_file(spec.trace, ec)) {
+    // A hid-recorder file of several nodes (a tablet's pad and pen, a keydial's two interfaces):
+    // the box plays the busiest one (its path in the replay is FILE#N).
+    auto recording = sim::readHidRecording(spec.trace);
+    if (!recording) return std::unexpected(recording.error());
+    if (recording->devices.size() > 1) {
+      const auto busiest = std::ranges::max_element(recording->devices, {},
+                                                    [](const sim::HidRecordedDevice& d) { return d.reports.size(); });
+      request.match.path = fmt::format("{}#{}", spec.trace.string(), busiest->index);
+    }
+  }
   // The SGI box answers its reset within milliseconds; a retry with nothing on the port must not
   // hold the frame loop for the backend's default second.
   if (spec.backend == DeviceBackend::kSerial) request.options["reset_timeout_ms"] = "200";

@@ -279,7 +279,7 @@ TEST(ManifestErrors, DevicesAreCoherent) {
   EXPECT_TRUE(hasError(r, 9, "'77d:410' is not VVVV:PPPP")) << r.text;
   EXPECT_TRUE(hasError(r, 10, "the replay backend needs trace")) << r.text;
   EXPECT_TRUE(hasError(r, 16, "has no trace.toml")) << r.text;
-  EXPECT_TRUE(hasError(r, 19, "'bluetooth' is not one of hid, v4l2, libcamera, replay or synthetic")) << r.text;
+  EXPECT_TRUE(hasError(r, 19, "'bluetooth' is not one of hid, serial, v4l2, libcamera, replay or synthetic")) << r.text;
   const auto ok = f.read("[devices.d]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"site.trace\"\n");
   ASSERT_TRUE(ok.manifest) << ok.text;
   EXPECT_EQ(ok.manifest->devices[0].trace, fs::canonical(f.dir / "site.trace"));
@@ -359,7 +359,7 @@ TEST(ManifestErrors, GainAccelerationAndOverridesAreChecked) {
 TEST(ManifestBindings, OverridesChangeOneDialOfLavasTable) {
   ShowFolder f("overrides");
   const auto r = f.read(
-      "[devices.dials]\nkind = \"dial_box\"\nbackend = \"synthetic\"\ngain = 0.5\nacceleration = 2\n"
+      "[devices.dials]\nkind = \"dial_box\"\nbackend = \"hid\"\ngain = 0.5\nacceleration = 2\n"
       "[[bindings]]\ndevice = \"dials\"\ndial = 1\naction = \"scale\"\n"
       "[[bindings]]\ndevice = \"dials\"\ndial = 4\ngain = 3\nacceleration = 0\ninvert = true\n"
       "[[bindings]]\ndevice = \"dials\"\ndial = 9\naction = \"rotate_z\"\ngain = 90\n"
