@@ -274,7 +274,9 @@ class CameraStream final : public TextureStream {
         return !texture_->showingFallback();
       case CameraLoss::kColour:
         if (!showingLoss_) {
-          texture_->setFallbackColor(lossColour_[0] / 255.0f, lossColour_[1] / 255.0f, lossColour_[2] / 255.0f);
+          texture_->setFallbackColor(static_cast<float>(lossColour_[0]) / 255.0f,
+                                     static_cast<float>(lossColour_[1]) / 255.0f,
+                                     static_cast<float>(lossColour_[2]) / 255.0f);
           texture_->showFallback();
           texture_->publish(textures);
           showingLoss_ = true;

@@ -13,9 +13,7 @@ namespace {
 class MatroskaWriter final : public sim::TraceVideoWriter {
  public:
   MatroskaWriter(std::filesystem::path path, devices::VideoMode mode) : path_(std::move(path)), mode_(mode) {}
-  ~MatroskaWriter() override {
-    if (writer_) (void)writer_->finish();
-  }
+  ~MatroskaWriter() override = default;  // media's writer finishes its file when destroyed
   MatroskaWriter(const MatroskaWriter&) = delete;
   MatroskaWriter& operator=(const MatroskaWriter&) = delete;
 
