@@ -10,6 +10,7 @@
 #include "kiosk/commands.h"
 #include "kiosk/device_wiring.h"
 #include "kiosk/options.h"
+#include "kiosk/trace_video_glue.h"
 #include "runtime/log.h"
 #include "sim/providers.h"
 
@@ -62,7 +63,7 @@ int devicesMain(std::span<const std::string_view> args) {
   std::vector<std::unique_ptr<devices::DeviceProvider>> providers = allProviders(ports);
   if (!synthetic) std::erase_if(providers, [](const auto& p) { return p->backend() == "synthetic"; });
   for (const std::string& path : replays) {
-    auto replay = std::make_unique<sim::ReplayProvider>();
+    auto replay = std::make_unique<sim::ReplayProvider>(matroskaTraceReaderFactory());
     std::error_code ec;
     auto r = std::filesystem::is_directory(path, ec) ? replay->addTrace(path) : replay->addHidRecording(path);
     if (!r) {

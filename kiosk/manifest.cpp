@@ -20,6 +20,7 @@
 #include <fmt/std.h>
 
 #include "kiosk/time_zone.h"
+#include "sim/hid_recording.h"
 
 namespace basalt::kiosk {
 
@@ -99,6 +100,7 @@ std::string_view deviceBackendName(DeviceBackend backend) {
     case DeviceBackend::kLibcamera: return "libcamera";
     case DeviceBackend::kReplay: return "replay";
     case DeviceBackend::kSynthetic: return "synthetic";
+    case DeviceBackend::kSerial: return "serial";
   }
   return "?";
 }
@@ -292,6 +294,9 @@ Result<std::filesystem::path> confinePath(const std::filesystem::path& folder, s
 // ---- The reader -----------------------------------------------------------------------------
 
 namespace {
+
+// LAVA's dial table has a default action for dials 0 to 7.
+constexpr std::uint16_t kLavaDials = 8;
 
 const std::set<std::string, std::less<>> kScriptExtensions{".mdl"};
 const std::set<std::string, std::less<>> kSceneExtensions{".sce"};
@@ -579,8 +584,9 @@ class Reader {
   }
 
   /// A path in the manifest: resolved, confined, and checked to exist.
+  /// `wantFolder`: true a folder, false a regular file, nullopt either.
   std::optional<std::filesystem::path> filePath(const toml::node& node, std::string_view text, std::string_view what,
-                                                bool wantFolder = false) {
+                                                std::optional<bool> wantFolder = false) {
     auto resolved = confinePath(folder_, text);
     if (!resolved) {
       error(lineOf(node), fmt::format("{}: {}", what, resolved.error().message()));
@@ -592,11 +598,11 @@ class Reader {
       error(lineOf(node), fmt::format("{}: '{}' does not exist (looked for {})", what, text, resolved->string()));
       return std::nullopt;
     }
-    if (wantFolder && !std::filesystem::is_directory(status)) {
+    if (wantFolder == true && !std::filesystem::is_directory(status)) {
       error(lineOf(node), fmt::format("{}: '{}' must be a folder", what, text));
       return std::nullopt;
     }
-    if (!wantFolder && !std::filesystem::is_regular_file(status)) {
+    if (wantFolder == false && !std::filesystem::is_regular_file(status)) {
       error(lineOf(node), fmt::format("{}: '{}' is not a regular file", what, text));
       return std::nullopt;
     }
@@ -813,6 +819,14 @@ class Reader {
     v.viewport = values;
   }
 
+  /// Why a hid-recorder file cannot be replayed as a dial box, or nothing.
+  static std::optional<std::string> checkHidRecording(const std::filesystem::path& file) {
+    auto recording = sim::readHidRecording(file);
+    if (!recording) return fmt::format("is not a hid-recorder file: {}", recording.error().message());
+    if (recording->devices.empty()) return std::string("records no device (no R: or E: lines)");
+    return std::nullopt;
+  }
+
   // ---- [devices.NAME] ----
   void readDevices(const toml::table& devices) {
     for (auto&& [k, node] : devices) {
@@ -826,48 +840,69 @@ class Reader {
       DeviceSpec d;
       d.name = name;
       d.line = lineOf(*t);
-      checkKeys(*t, path, {"kind", "backend", "match", "trace", "script", "loop", "required", "size"});
+      checkKeys(*t, path,
+                {"kind", "backend", "match", "trace", "script", "loop", "required", "size", "gain", "acceleration",
+                 "mirror", "faults"});
       const auto kind =
           choice<DeviceKind>(*t, "kind", path, {{"dial_box", DeviceKind::kDialBox}, {"camera", DeviceKind::kCamera}});
       if (!t->get("kind")) error(d.line, fmt::format("{}: needs kind = \"dial_box\" or \"camera\"", path));
       if (kind) d.kind = *kind;
       const auto backend = choice<DeviceBackend>(*t, "backend", path,
                                                  {{"hid", DeviceBackend::kHid},
+                                                  {"serial", DeviceBackend::kSerial},
                                                   {"v4l2", DeviceBackend::kV4l2},
                                                   {"libcamera", DeviceBackend::kLibcamera},
                                                   {"replay", DeviceBackend::kReplay},
                                                   {"synthetic", DeviceBackend::kSynthetic}});
       if (!t->get("backend")) {
-        error(d.line, fmt::format("{}: needs backend = \"hid\", \"v4l2\", \"libcamera\", \"replay\" or "
-                                  "\"synthetic\"",
+        error(d.line, fmt::format("{}: needs backend = \"hid\", \"serial\", \"v4l2\", \"libcamera\", \"replay\" "
+                                  "or \"synthetic\"",
                                   path));
       }
       if (backend) d.backend = *backend;
       if (kind && backend) {
         const bool dialBackend = *backend == DeviceBackend::kHid || *backend == DeviceBackend::kReplay ||
-                                 *backend == DeviceBackend::kSynthetic;
-        const bool cameraBackend = *backend != DeviceBackend::kHid;
+                                 *backend == DeviceBackend::kSynthetic || *backend == DeviceBackend::kSerial;
+        const bool cameraBackend = *backend != DeviceBackend::kHid && *backend != DeviceBackend::kSerial;
         if ((*kind == DeviceKind::kDialBox && !dialBackend) || (*kind == DeviceKind::kCamera && !cameraBackend)) {
           error(lineOf(*t->get("backend")),
-                fmt::format("{}: a {} cannot use the {} backend; a dial_box uses hid, replay or synthetic, a camera "
-                            "v4l2, libcamera, replay or synthetic",
+                fmt::format("{}: a {} cannot use the {} backend; a dial_box uses hid, serial, replay or synthetic, a "
+                            "camera v4l2, libcamera, replay or synthetic",
                             path, deviceKindName(*kind), deviceBackendName(*backend)));
         }
       }
       if (const toml::table* m = table(*t, "match", path)) readMatch(*m, path + ".match", d);
+      if (d.backend == DeviceBackend::kSerial && d.match.path.empty() && d.kind == DeviceKind::kDialBox) {
+        error(d.line,
+              fmt::format("{}: the serial backend needs the port: match = {{ path = \"/dev/ttyUSB0\" }}", path));
+      }
       if (const toml::node* trace = t->get("trace")) {
         if (const auto* s = trace->as_string()) {
-          if (auto p = filePath(*trace, s->get(), path + ".trace", true)) {
+          // A NAME.trace folder from 'basalt record', or (dial boxes) a file from hid-tools'
+          // hid-recorder, recorded on any machine.
+          if (auto p = filePath(*trace, s->get(), path + ".trace", std::nullopt)) {
             std::error_code ec;
-            if (!std::filesystem::is_regular_file(*p / "trace.toml", ec)) {
-              error(lineOf(*trace),
-                    fmt::format("{}.trace: '{}' has no trace.toml; record one with 'basalt record'", path, s->get()));
+            if (std::filesystem::is_regular_file(*p, ec)) {
+              if (d.kind == DeviceKind::kCamera) {
+                error(lineOf(*trace), fmt::format("{}.trace: '{}' is a file; a camera replays a NAME.trace folder "
+                                                  "(record one with 'basalt record')",
+                                                  path, s->get()));
+              } else if (auto bad = checkHidRecording(*p)) {
+                error(lineOf(*trace), fmt::format("{}.trace: '{}' {}", path, s->get(), *bad));
+              } else {
+                d.trace = *p;
+              }
+            } else if (!std::filesystem::is_regular_file(*p / "trace.toml", ec)) {
+              error(lineOf(*trace), fmt::format("{}.trace: '{}' has no trace.toml; record one with 'basalt record', "
+                                                "or name a hid-recorder file",
+                                                path, s->get()));
             } else {
               d.trace = *p;
             }
           }
         } else {
-          error(lineOf(*trace), fmt::format("{}.trace: must be the name of a NAME.trace folder", path));
+          error(lineOf(*trace),
+                fmt::format("{}.trace: must be the name of a NAME.trace folder or a hid-recorder file", path));
         }
       }
       if (d.backend == DeviceBackend::kReplay && !t->get("trace")) {
@@ -891,6 +926,25 @@ class Reader {
         } else {
           d.width = mode->width;
           d.height = mode->height;
+        }
+      }
+      if (auto mirror = boolean(*t, "mirror", path)) {
+        d.mirror = *mirror;
+        if (d.kind != DeviceKind::kCamera) {
+          warning(lineOf(*t->get("mirror")), fmt::format("{}.mirror: only cameras mirror; this is ignored", path));
+        }
+      }
+      if (const toml::node* faults = t->get("faults")) {
+        if (d.kind != DeviceKind::kCamera || d.backend != DeviceBackend::kSynthetic) {
+          warning(lineOf(*faults), fmt::format("{}.faults: only synthetic cameras play faults; this is ignored", path));
+        }
+        readSyntheticFaults(*faults, path, d);
+      }
+      if (auto gain = number(*t, "gain", path, -1e6, 1e6)) d.gain = *gain;
+      if (auto acceleration = number(*t, "acceleration", path, 0, 1e3)) d.acceleration = *acceleration;
+      for (const char* key : {"gain", "acceleration"}) {
+        if (t->get(key) && d.kind != DeviceKind::kDialBox) {
+          warning(lineOf(*t->get(key)), fmt::format("{}.{}: only dial boxes have one; this is ignored", path, key));
         }
       }
       manifest_.devices.push_back(std::move(d));
@@ -927,9 +981,50 @@ class Reader {
       }
     }
     if (auto serial = string(m, "serial", path)) d.match.serial = *serial;
+    if (auto p = string(m, "path", path); p && d.backend == DeviceBackend::kSerial && !p->starts_with("/dev/")) {
+      error(lineOf(*m.get("path")), fmt::format("{}.path: '{}': the serial backend needs a /dev node", path, *p));
+    }
     if (d.backend == DeviceBackend::kSynthetic || d.backend == DeviceBackend::kReplay) {
       warning(lineOf(m), fmt::format("{}: the {} backend matches no hardware; this is ignored", path,
                                      deviceBackendName(d.backend)));
+    }
+  }
+
+  void readSyntheticFaults(const toml::node& node, const std::string& path, DeviceSpec& d) {
+    const toml::array* a = node.as_array();
+    if (!a) {
+      error(lineOf(node), fmt::format("{}.faults: must be an array of {{ at = \"2s\", fault = \"unplug\" }}", path));
+      return;
+    }
+    Nanos last{0};
+    std::size_t i = 0;
+    for (const toml::node& item : *a) {
+      const std::string ip = fmt::format("{}.faults[{}]", path, i++);
+      const toml::table* t = item.as_table();
+      if (!t) {
+        error(lineOf(item), fmt::format("{}: must be {{ at = \"2s\", fault = \"unplug\" }}", ip));
+        continue;
+      }
+      checkKeys(*t, ip, {"at", "fault", "for"});
+      SyntheticFault f;
+      if (auto at = duration(*t, "at", ip)) {
+        if (*at < last) error(lineOf(*t), fmt::format("{}: times must not go backwards", ip));
+        f.at = last = *at;
+      } else if (!t->get("at")) {
+        error(lineOf(*t), fmt::format("{}: needs at = \"TIME\" after the camera opens", ip));
+      }
+      const auto kind = choice<SyntheticFault::Kind>(*t, "fault", ip,
+                                                     {{"unplug", SyntheticFault::Kind::kUnplug},
+                                                      {"signal_lost", SyntheticFault::Kind::kSignalLost},
+                                                      {"stall", SyntheticFault::Kind::kStall}});
+      if (!t->get("fault"))
+        error(lineOf(*t), fmt::format("{}: needs fault = \"unplug\", \"signal_lost\" or \"stall\"", ip));
+      if (kind) f.kind = *kind;
+      if (auto length = duration(*t, "for", ip)) f.duration = *length;
+      if (kind && *kind != SyntheticFault::Kind::kUnplug && !t->get("for")) {
+        error(lineOf(*t), fmt::format("{}: needs for = \"TIME\" (how long it lasts)", ip));
+      }
+      d.faults.push_back(f);
     }
   }
 
@@ -949,7 +1044,7 @@ class Reader {
         error(lineOf(item), fmt::format("{}: must be {{ at = \"1s\", dial = 0, turns = 0.25 }}", ip));
         continue;
       }
-      checkKeys(*t, ip, {"at", "dial", "turns", "button", "pressed"});
+      checkKeys(*t, ip, {"at", "dial", "turns", "button", "pressed", "shuttle", "position"});
       SyntheticInput in;
       const auto at = duration(*t, "at", ip);
       if (!t->get("at")) error(lineOf(*t), fmt::format("{}: needs at = \"TIME\" after the device opens", ip));
@@ -958,12 +1053,23 @@ class Reader {
       if (at) last = *at;
       const bool dial = t->get("dial") != nullptr;
       const bool button = t->get("button") != nullptr;
-      if (dial == button) {
-        error(lineOf(*t), fmt::format("{}: give either dial = N with turns, or button = N with pressed", ip));
+      const bool shuttle = t->get("shuttle") != nullptr;
+      if (int{dial} + int{button} + int{shuttle} != 1) {
+        error(lineOf(*t), fmt::format("{}: give one of dial = N with turns, button = N with pressed, or shuttle = N "
+                                      "with position",
+                                      ip));
         continue;
       }
       in.button = button;
-      if (dial) {
+      in.shuttle = shuttle;
+      if (shuttle) {
+        // A shuttle ring held off-centre (-1..1, full deflection at the ends) until the next one.
+        if (auto index = integer(*t, "shuttle", ip, 0, 7)) in.index = static_cast<std::uint16_t>(*index);
+        if (auto position = number(*t, "position", ip, -1, 1)) in.value = *position;
+        if (!t->get("position")) {
+          error(lineOf(*t), fmt::format("{}: needs position = N (-1 to 1; 0 lets the ring go)", ip));
+        }
+      } else if (dial) {
         if (auto index = integer(*t, "dial", ip, 0, 7)) in.index = static_cast<std::uint16_t>(*index);
         if (auto turns = number(*t, "turns", ip, -100, 100)) in.value = *turns;
         if (!t->get("turns")) error(lineOf(*t), fmt::format("{}: needs turns = N (fractions of a full turn)", ip));
@@ -988,7 +1094,7 @@ class Reader {
       MediaSpec m;
       m.name = name;
       m.line = lineOf(*t);
-      checkKeys(*t, path, {"kind", "file", "device", "loop", "audio"});
+      checkKeys(*t, path, {"kind", "file", "device", "loop", "audio", "on_loss"});
       const auto kind = choice<MediaKind>(
           *t, "kind", path,
           {{"movie", MediaKind::kMovie}, {"image", MediaKind::kImage}, {"camera", MediaKind::kCamera}});
@@ -1012,8 +1118,12 @@ class Reader {
         } else if (!t->get("device")) {
           error(m.line, fmt::format("{}: a camera needs device = \"NAME\" from [devices]", path));
         }
+        if (auto loss = string(*t, "on_loss", path)) readCameraLoss(*loss, lineOf(*t->get("on_loss")), path, m);
       } else if (kind) {
         if (t->get("device")) warning(lineOf(*t->get("device")), fmt::format("{}.device: only cameras have one", path));
+        if (t->get("on_loss")) {
+          warning(lineOf(*t->get("on_loss")), fmt::format("{}.on_loss: only cameras are lost; this is ignored", path));
+        }
         if (const toml::node* file = t->get("file")) {
           if (const auto* s = file->as_string()) {
             const auto& extensions = *kind == MediaKind::kMovie ? kMovieExtensions : kImageExtensions;
@@ -1032,6 +1142,30 @@ class Reader {
         }
       }
       manifest_.media.push_back(std::move(m));
+    }
+  }
+
+  /// `on_loss`: "fallback", "last_frame", "test_pattern" or a colour "#RRGGBB".
+  void readCameraLoss(const std::string& text, int line, const std::string& path, MediaSpec& m) {
+    if (text == "fallback") {
+      m.onLoss = CameraLoss::kFallbackImage;
+    } else if (text == "last_frame") {
+      m.onLoss = CameraLoss::kLastFrame;
+    } else if (text == "test_pattern") {
+      m.onLoss = CameraLoss::kTestPattern;
+    } else {
+      unsigned rgb = 0;
+      const bool hex = text.size() == 7 && text[0] == '#' &&
+                       std::from_chars(text.data() + 1, text.data() + 7, rgb, 16).ptr == text.data() + 7;
+      if (!hex) {
+        error(line, fmt::format("{}.on_loss: '{}' is not one of fallback, last_frame, test_pattern or a colour "
+                                "\"#RRGGBB\"",
+                                path, text));
+        return;
+      }
+      m.onLoss = CameraLoss::kColour;
+      m.lossColour = {static_cast<std::uint8_t>(rgb >> 16), static_cast<std::uint8_t>(rgb >> 8),
+                      static_cast<std::uint8_t>(rgb)};
     }
   }
 
@@ -1055,7 +1189,7 @@ class Reader {
       }
       BindingSpec b;
       b.line = lineOf(*t);
-      checkKeys(*t, path, {"device", "dial", "button", "action", "gain"});
+      checkKeys(*t, path, {"device", "dial", "button", "action", "gain", "acceleration", "invert"});
       auto device = string(*t, "device", path);
       if (!t->get("device")) error(b.line, fmt::format("{}: needs device = \"NAME\" from [devices]", path));
       const DeviceSpec* d = device ? manifest_.findDevice(*device) : nullptr;
@@ -1079,7 +1213,12 @@ class Reader {
       const std::int64_t maxIndex =
           button ? 31 : (synthetic ? 7 : static_cast<std::int64_t>(runtime::kMaxBoundDials) - 1);
       if (auto i = integer(*t, button ? "button" : "dial", path, 0, maxIndex)) b.index = static_cast<std::uint16_t>(*i);
-      if (!t->get("action")) error(b.line, fmt::format("{}: needs action = \"...\"", path));
+      // A dial of LAVA's table may keep its action and change only its gain or acceleration.
+      b.actionGiven = t->get("action") != nullptr;
+      if (!b.actionGiven && (button || b.index >= kLavaDials)) {
+        error(b.line, fmt::format("{}: needs action = \"...\"{}", path,
+                                  button ? "" : " (only dials 0 to 7 have a default action, LAVA's)"));
+      }
       if (dial) {
         if (auto action = choice<runtime::Action>(*t, "action", path,
                                                   {{"none", runtime::Action::kNone},
@@ -1093,7 +1232,20 @@ class Reader {
           b.action = *action;
           b.gain = defaultGain(*action);
         }
-        if (auto gain = number(*t, "gain", path, -1e6, 1e6)) b.gain = *gain;
+        if (!b.actionGiven && b.index < kLavaDials) {
+          b.action = runtime::Bindings::lavaDefaults().dial(b.index).action;
+          b.gain = defaultGain(b.action);
+        }
+        if (auto gain = number(*t, "gain", path, -1e6, 1e6)) {
+          b.gain = *gain;
+          b.gainGiven = true;
+        }
+        if (auto acceleration = number(*t, "acceleration", path, 0, 1e3)) b.acceleration = *acceleration;
+        if (auto invert = boolean(*t, "invert", path)) b.invert = *invert;
+        if (b.action == runtime::Action::kNone && (t->get("gain") || t->get("acceleration") || t->get("invert"))) {
+          warning(b.line, fmt::format("{}: dial {} does nothing, so its gain, acceleration and invert do nothing", path,
+                                      b.index));
+        }
       } else {
         if (auto action = choice<KioskAction>(*t, "action", path,
                                               {{"none", KioskAction::kNone},
@@ -1102,7 +1254,9 @@ class Reader {
                                                {"reset_view", KioskAction::kResetView}})) {
           b.kioskAction = *action;
         }
-        if (t->get("gain")) warning(lineOf(*t->get("gain")), fmt::format("{}.gain: buttons have no gain", path));
+        for (const char* key : {"gain", "acceleration", "invert"}) {
+          if (t->get(key)) warning(lineOf(*t->get(key)), fmt::format("{}.{}: buttons have no {}", path, key, key));
+        }
       }
       if (!seen.insert({b.device, b.button, b.index}).second) {
         error(b.line,

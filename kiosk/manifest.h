@@ -129,18 +129,28 @@ enum class MediaKind : std::uint8_t { kMovie, kImage, kCamera };
 std::string_view mediaKindName(MediaKind kind);
 
 /// \brief `[media.NAME]`: a movie, an image or a live camera that textures can show.
+/// \brief What a camera's texture shows while the camera is lost or not there yet.
+enum class CameraLoss : std::uint8_t {
+  kFallbackImage,  ///< the texture's `fallback` image (black without one): the default
+  kLastFrame,      ///< the last frame it showed (the fallback image until there was one)
+  kTestPattern,    ///< colour bars
+  kColour,         ///< one colour
+};
+
 struct MediaSpec {
   std::string name;
   MediaKind kind = MediaKind::kMovie;
-  std::filesystem::path file;  ///< movie and image
-  std::string device;          ///< camera: a name from [devices]
-  bool loop = true;            ///< movie
-  bool audio = false;          ///< movie: play its sound
+  std::filesystem::path file;                      ///< movie and image
+  std::string device;                              ///< camera: a name from [devices]
+  bool loop = true;                                ///< movie
+  bool audio = false;                              ///< movie: play its sound
+  CameraLoss onLoss = CameraLoss::kFallbackImage;  ///< camera: what shows while it is lost
+  std::array<std::uint8_t, 3> lossColour{};        ///< camera: RGB for CameraLoss::kColour
   int line = 0;
 };
 
 enum class DeviceKind : std::uint8_t { kDialBox, kCamera };
-enum class DeviceBackend : std::uint8_t { kHid, kV4l2, kLibcamera, kReplay, kSynthetic };
+enum class DeviceBackend : std::uint8_t { kHid, kV4l2, kLibcamera, kReplay, kSynthetic, kSerial };
 std::string_view deviceKindName(DeviceKind kind);
 std::string_view deviceBackendName(DeviceBackend backend);
 
@@ -158,8 +168,17 @@ struct DeviceMatch {
 struct SyntheticInput {
   Nanos at{0};
   bool button = false;
+  bool shuttle = false;  ///< a shuttle ring held at `value` (-1..1) until the next shuttle input
   std::uint16_t index = 0;
   double value = 0;  ///< turns for a dial; 1 pressed, 0 released for a button
+};
+
+/// \brief A scripted fault of a synthetic camera (tests and demos of the fallbacks).
+struct SyntheticFault {
+  enum class Kind : std::uint8_t { kUnplug, kSignalLost, kStall };
+  Nanos at{0};  ///< after the camera opens
+  Kind kind = Kind::kUnplug;
+  Nanos duration{0};  ///< signal_lost and stall
 };
 
 /// \brief `[devices.NAME]`.
@@ -168,12 +187,16 @@ struct DeviceSpec {
   DeviceKind kind = DeviceKind::kDialBox;
   DeviceBackend backend = DeviceBackend::kSynthetic;
   DeviceMatch match;
-  std::filesystem::path trace;         ///< replay: the NAME.trace folder
+  std::filesystem::path trace;         ///< replay: the NAME.trace folder, or a hid-recorder file (dial boxes)
   std::vector<SyntheticInput> script;  ///< synthetic dial box: what it does
   bool loop = true;                    ///< synthetic and replay: start again at the end
   bool required = false;               ///< the show does not start without it (default: it waits)
   std::optional<std::uint32_t> width;  ///< camera: requested size
   std::optional<std::uint32_t> height;
+  bool mirror = false;                 ///< camera: flip left-right (in the device, else the renderer)
+  std::vector<SyntheticFault> faults;  ///< synthetic camera: what goes wrong, when
+  double gain = 1;                     ///< dial box: multiplies every dial's gain
+  double acceleration = 0;             ///< dial box: every dial's acceleration unless a binding says otherwise
   int line = 0;
 };
 
@@ -188,6 +211,10 @@ struct BindingSpec {
   runtime::Action action = runtime::Action::kNone;  ///< dials
   KioskAction kioskAction = KioskAction::kNone;     ///< buttons
   double gain = 0;
+  bool actionGiven = true;             ///< dials: false keeps LAVA's action for the dial
+  bool gainGiven = false;              ///< dials: `gain` was written (else the action's default)
+  std::optional<double> acceleration;  ///< dials: overrides the device's acceleration
+  bool invert = false;                 ///< dials: turns the other way
   int line = 0;
 };
 

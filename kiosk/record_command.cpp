@@ -11,6 +11,7 @@
 #include "kiosk/commands.h"
 #include "kiosk/device_wiring.h"
 #include "kiosk/options.h"
+#include "kiosk/trace_video_glue.h"
 #include "runtime/event_loop.h"
 #include "runtime/log.h"
 #include "sim/raw_video.h"
@@ -36,9 +37,11 @@ Options:
   --seconds S       stop after S seconds (default: until Ctrl-C or SIGTERM)
   --fast            run on a manual clock as fast as possible (synthetic devices only)
   --fps F           the show's frame rate noted in the trace (default 60)
+  --raw-video       write camera video as uncompressed .bvraw files instead of Matroska
   -h, --help        this text
 
-Video is written as uncompressed .bvraw files in this build (Matroska comes from media/).
+Camera video is written as Matroska (NAME.mkv): the frames as the camera gave them (raw YUV or
+MJPEG, not re-encoded) with their timestamps to the microsecond.
 See 'basalt devices' for what is connected.
 Exit status: 0 recorded, 1 could not record, 2 usage error.
 )";
@@ -53,13 +56,15 @@ int recordMain(std::span<const std::string_view> args) {
                               {"--synthetic"},
                               {"--seconds", true},
                               {"--fast"},
-                              {"--fps", true}});
+                              {"--fps", true},
+                              {"--raw-video"}});
   if (!parsed) return usageError(parsed.error().describe());
   std::filesystem::path output;
   std::vector<devices::DeviceRequest> requests;
   std::optional<double> seconds;
   bool fast = false;
   double fps = 60;
+  bool rawVideo = false;
   int dials = 0, cameras = 0;
   for (const ParsedOption& o : *parsed) {
     if (o.name.empty()) return usageError(fmt::format("unexpected argument '{}'; see 'basalt record --help'", o.value));
@@ -68,6 +73,7 @@ int recordMain(std::span<const std::string_view> args) {
       return 0;
     }
     if (o.name == "--output") output = std::filesystem::path(o.value);
+    if (o.name == "--raw-video") rawVideo = true;
     if (o.name == "--dial" || o.name == "--camera" || o.name == "--synthetic") {
       const bool dial = o.name == "--dial";
       auto add = [&](std::string_view spec, bool isDial) -> Result<void> {
@@ -135,7 +141,9 @@ int recordMain(std::span<const std::string_view> args) {
   }
   char host[256] = {};
   ::gethostname(host, sizeof host - 1);
-  auto recorder = sim::TraceRecorder::create(output, clock, {host, "basalt 0.1.0", fps, sim::rawVideoWriterFactory()});
+  auto recorder = sim::TraceRecorder::create(
+      output, clock,
+      {host, "basalt 0.1.0", fps, rawVideo ? sim::rawVideoWriterFactory() : matroskaTraceWriterFactory()});
   if (!recorder) {
     fmt::print(stderr, "basalt: error: cannot record: {}\n", recorder.error().describe());
     return 1;

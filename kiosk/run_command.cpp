@@ -30,6 +30,7 @@
 #include "kiosk/status_server.h"
 #include "kiosk/stream_factories.h"
 #include "kiosk/supervisor.h"
+#include "kiosk/trace_video_glue.h"
 #include "media/image_io.h"
 #include "render/output.h"
 #include "render/renderer.h"
@@ -637,7 +638,7 @@ int runShow(const RunOptions& options) {
   std::unique_ptr<DeviceWiring> devices;
   if (options.replay) {
     devices = std::make_unique<DeviceWiring>(clock, [eventLoop] { eventLoop->wake(); });
-    if (auto r = devices->addReplay(*options.replay, !options.replayOnce); !r) {
+    if (auto r = devices->addReplay(*options.replay, !options.replayOnce, matroskaTraceReaderFactory()); !r) {
       return failWith(r.error(), "cannot replay");
     }
     frameLoop.addParticipant(devices->participant());

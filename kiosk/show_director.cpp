@@ -285,6 +285,8 @@ void ShowDirector::serviceDevices(Nanos now) {
     box.service(now);
     if (box.state() != slot.state) {
       if (slot.state == devices::DeviceState::kLive) {
+        // Its bindings let go: a shuttle held when the cable was pulled stops turning.
+        slot.dials.apply(Event{now, static_cast<DeviceId>(i + 1), EventKind::kDeviceState, 0, 0.0}, context_.show);
         log::warn(kLogDirector, "device '{}' is {}; its bindings are quiet until it comes back", slot.spec.name,
                   devices::deviceStateName(box.state()));
         slot.nextAttempt = now + slot.backoff;
@@ -329,6 +331,14 @@ void ShowDirector::applyInput(Nanos until) {
                                }
                                slot.dials.apply(e, context_.show);
                              });
+}
+
+void ShowDirector::advanceShuttles(Nanos now) {
+  // Shuttle rings held off-centre turn the show by the show time since the last frame.
+  if (player_ && lastAdvance_.count() >= 0 && now > lastAdvance_) {
+    for (DeviceSlot& slot : show_->devices) slot.dials.advance(now - lastAdvance_, context_.show);
+  }
+  lastAdvance_ = now;
 }
 
 void ShowDirector::applyProgramme(Nanos now) {
@@ -411,6 +421,7 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
   const Nanos now = frame.time;
   serviceDevices(now);
   applyInput(now);
+  advanceShuttles(now);
   if (policy_->update(now, context_.clock.wallNow())) applyProgramme(now);
   if (player_) {
     if (auto r = player_->beforeDraw(frame, context_.show); !r) {

@@ -81,6 +81,7 @@ class ShowDirector final : public FrameParticipant {
   void handleControls(const FrameContext& frame);
   void serviceDevices(Nanos now);
   void applyInput(Nanos until);
+  void advanceShuttles(Nanos now);
   void applyProgramme(Nanos now);
   void updateStreams(Nanos now);
   void saveState(Nanos now);
@@ -98,6 +99,7 @@ class ShowDirector final : public FrameParticipant {
   bool displayOffUnsupported_ = false;
   std::set<std::string> reportedFailures_;
   Nanos lastSave_{0};
+  Nanos lastAdvance_{-1};  // the show time shuttle rings last turned the show to
 
   // Reload hand-over: the loader thread writes, the frame loop reads.
   std::mutex reloadMutex_;

@@ -19,7 +19,7 @@ namespace {
 struct Factories {
   std::mutex mutex;
   std::array<StreamFactory, 3> streams;  // by MediaKind; guarded by mutex
-  std::array<DialBoxFactory, 5> dials;   // by DeviceBackend; guarded by mutex
+  std::array<DialBoxFactory, 6> dials;   // by DeviceBackend; guarded by mutex
 };
 
 Factories& factories() {
@@ -38,7 +38,9 @@ Result<std::unique_ptr<devices::DialBox>> makeDialBox(const DeviceSpec& spec, co
     std::vector<sim::ScriptedInput> script;
     script.reserve(spec.script.size());
     for (const SyntheticInput& in : spec.script) {
-      script.push_back({in.at, in.button ? EventKind::kButton : EventKind::kDialDelta, in.index, in.value});
+      const EventKind kind =
+          in.button ? EventKind::kButton : (in.shuttle ? EventKind::kShuttle : EventKind::kDialDelta);
+      script.push_back({in.at, kind, in.index, in.value});
     }
     return std::make_unique<sim::SyntheticDial>(std::move(script), clock, spec.loop);
   }
@@ -107,17 +109,26 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
       } else {
         slot.unavailable = box.error().message();
       }
-      bool bound = false;
+      // LAVA's dial table with the device's gain and acceleration, then each binding's
+      // override of one dial (the others keep LAVA's action).
+      slot.dials = runtime::Bindings::lavaDefaults();
+      slot.dials.setGain(spec.gain);
+      slot.dials.setAcceleration(spec.acceleration);
       for (const BindingSpec& b : m.bindings) {
         if (b.device != spec.name) continue;
-        bound = true;
         if (b.button) {
           slot.buttons[b.index] = b.kioskAction;
-        } else {
-          slot.dials.setDial(b.index, {b.action, b.gain});
+          continue;
         }
+        runtime::DialBinding dial = slot.dials.dial(b.index);
+        if (b.actionGiven || b.gainGiven) {
+          dial.action = b.action;
+          dial.gain = b.gain;
+        }
+        dial.acceleration = b.acceleration.value_or(spec.acceleration);
+        dial.invert = b.invert;
+        slot.dials.setDial(b.index, dial);
       }
-      if (!bound) slot.dials = runtime::Bindings::lavaDefaults();
     } else {
       // A camera is opened and kept by the texture stream of the media that shows it (its own
       // DeviceManager); its slot only names it in the status.

@@ -1,7 +1,9 @@
 #include "kiosk/stream_factories.h"
 
 #include "kiosk/script_player.h"
+#include "kiosk/trace_video_glue.h"
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 
@@ -10,10 +12,13 @@
 
 #include "devices/hid/hid_backend.h"
 #include "devices/libcamera/libcamera_camera.h"
+#include "devices/serial/sgi_dial_box.h"
 #include "devices/v4l2/v4l2_camera.h"
 #include "media/movie_player.h"
 #include "render/stream_texture.h"
 #include "runtime/log.h"
+#include "runtime/test_pattern.h"
+#include "sim/hid_recording.h"
 #include "sim/providers.h"
 
 namespace basalt::kiosk {
@@ -194,9 +199,15 @@ Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, c
 
 class CameraStream final : public TextureStream {
  public:
-  CameraStream(std::string media, std::unique_ptr<devices::DeviceProvider> provider, devices::DeviceRequest request,
-               const Clock& clock)
-      : media_(std::move(media)), clock_(clock), events_(256), manager_(clock, events_), name_(request.name) {
+  CameraStream(const MediaSpec& media, std::unique_ptr<devices::DeviceProvider> provider,
+               devices::DeviceRequest request, const Clock& clock)
+      : media_(media.name),
+        onLoss_(media.onLoss),
+        lossColour_(media.lossColour),
+        clock_(clock),
+        events_(256),
+        manager_(clock, events_),
+        name_(request.name) {
     manager_.addProvider(std::move(provider));
     requested_ = manager_.request(std::move(request)).has_value();
     stream_ = manager_.videoStream(name_);
@@ -226,33 +237,98 @@ class CameraStream final : public TextureStream {
       }
       texture_ = std::move(*texture);
     }
+    // A camera that cannot flip in the device is mirrored by its texture.
+    texture_->setMirror(stream_->mirrorInRenderer());
     const FrameRef frame = stream_->frameAt(showTime);
-    if (stream_->health().state != SourceState::kLive) return false;
+    if (stream_->health().state != SourceState::kLive) return showLoss(textures);
     auto changed = texture_->update(frame);
     if (!changed) {
       log::warn(kLogStreams, "camera '{}': {}", media_, changed.error().describe());
       return false;
     }
+    if (*changed) showingLoss_ = false;
+    if (showingLoss_) return true;  // the loss picture stays until the camera's first new frame
     if (texture_->showingFallback()) return false;
     texture_->publish(textures);
     return true;
+  }
+
+  [[nodiscard]] std::string lossName() const {
+    switch (onLoss_) {
+      case CameraLoss::kFallbackImage: return "the texture's fallback image";
+      case CameraLoss::kLastFrame: return "its last frame";
+      case CameraLoss::kTestPattern: return "a test pattern";
+      case CameraLoss::kColour:
+        return fmt::format("#{:02x}{:02x}{:02x}", lossColour_[0], lossColour_[1], lossColour_[2]);
+    }
+    return "?";
+  }
+
+  /// While the camera is lost or not there yet: what the manifest's on_loss asks for. False
+  /// leaves the texture's fallback image to the director.
+  bool showLoss(render::TextureRegistry& textures) {
+    switch (onLoss_) {
+      case CameraLoss::kFallbackImage: return false;
+      case CameraLoss::kLastFrame:
+        // The texture keeps its last frame; before the first one there is none to keep.
+        return !texture_->showingFallback();
+      case CameraLoss::kColour:
+        if (!showingLoss_) {
+          texture_->setFallbackColor(static_cast<float>(lossColour_[0]) / 255.0f,
+                                     static_cast<float>(lossColour_[1]) / 255.0f,
+                                     static_cast<float>(lossColour_[2]) / 255.0f);
+          texture_->showFallback();
+          texture_->publish(textures);
+          showingLoss_ = true;
+        }
+        return true;
+      case CameraLoss::kTestPattern:
+        if (!showingLoss_) {
+          // Drawn once per loss, at the size of the last frame shown (else 640x360), in RGBA.
+          const render::Size size = texture_->showingFallback() || texture_->view().size.width == 0
+                                        ? render::Size{640, 360}
+                                        : texture_->view().size;
+          if (!patternPool_ || patternPool_->config().width != size.width ||
+              patternPool_->config().height != size.height) {
+            patternPool_ = FramePool::create({PixelFormat::kRgba8, size.width, size.height, 1, 1, true});
+          }
+          FrameRef pattern = patternPool_->acquire();
+          if (!pattern) return false;
+          drawTestPattern(*pattern, TestPattern::kColourBars, 0, false);
+          pattern->sequence = ++patternSequence_;
+          if (auto r = texture_->update(pattern); !r) {
+            log::warn(kLogStreams, "camera '{}': test pattern: {}", media_, r.error().describe());
+            return false;
+          }
+          texture_->publish(textures);
+          showingLoss_ = true;
+        }
+        return true;
+    }
+    return false;
   }
 
   [[nodiscard]] std::string describe() const override {
     for (const devices::DeviceStatus& s : manager_.status()) {
       if (s.name != name_) continue;
       if (s.state == devices::DeviceState::kLive) {
-        return fmt::format("camera {}: {}", devices::describeDevice(s.device),
-                           s.mode ? devices::describeMode(*s.mode) : std::string("live"));
+        return fmt::format("camera {}: {}{}", devices::describeDevice(s.device),
+                           s.mode ? devices::describeMode(*s.mode) : std::string("live"),
+                           texture_ && texture_->mirror() ? ", mirrored by the renderer" : "");
       }
-      return fmt::format("camera '{}' ({}) is {}: {}", name_, s.match, devices::deviceStateName(s.state),
-                         s.lastError.empty() ? std::string("looking for it") : s.lastError);
+      return fmt::format("camera '{}' ({}) is {}: {}; showing {}", name_, s.match, devices::deviceStateName(s.state),
+                         s.lastError.empty() ? std::string("looking for it") : s.lastError, lossName());
     }
     return fmt::format("camera '{}' was not requested", name_);
   }
 
  private:
   std::string media_;
+  CameraLoss onLoss_;
+  std::array<std::uint8_t, 3> lossColour_;
+  bool showingLoss_ = false;  // the loss picture is on the texture
+  std::shared_ptr<FramePool> patternPool_;
+  std::uint64_t patternSequence_ = 0;
   const Clock& clock_;
   BoundedQueue<Event> events_;  // state events of the manager; the status comes from status()
   devices::DeviceManager manager_;
@@ -282,7 +358,24 @@ Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, 
   if (spec->backend == DeviceBackend::kReplay || spec->backend == DeviceBackend::kSynthetic) {
     request.options["loop"] = spec->loop ? "true" : "false";
   }
-  return std::make_unique<CameraStream>(media.name, std::move(*provider), std::move(request), clock);
+  request.controls.mirror = spec->mirror;
+  if (spec->backend == DeviceBackend::kSynthetic && !spec->faults.empty()) {
+    std::string faults;
+    for (const SyntheticFault& f : spec->faults) {
+      if (!faults.empty()) faults += ',';
+      switch (f.kind) {
+        case SyntheticFault::Kind::kUnplug: faults += fmt::format("unplug@{}", f.at.count()); break;
+        case SyntheticFault::Kind::kSignalLost:
+          faults += fmt::format("signal_lost@{}+{}", f.at.count(), f.duration.count());
+          break;
+        case SyntheticFault::Kind::kStall:
+          faults += fmt::format("stall@{}+{}", f.at.count(), f.duration.count());
+          break;
+      }
+    }
+    request.options["faults"] = faults;
+  }
+  return std::make_unique<CameraStream>(media, std::move(*provider), std::move(request), clock);
 }
 
 Result<std::unique_ptr<devices::DialBox>> makeDialBoxFromSpec(const DeviceSpec& spec, const Clock& clock) {
@@ -293,6 +386,21 @@ Result<std::unique_ptr<devices::DialBox>> makeDialBoxFromSpec(const DeviceSpec& 
   request.kind = devices::DeviceKind::kDialBox;
   request.match = deviceMatchFor(spec);
   request.options["loop"] = spec.loop ? "true" : "false";
+  std::error_code ec;
+  if (spec.backend == DeviceBackend::kReplay && std::filesystem::is_regular_file(spec.trace, ec)) {
+    // A hid-recorder file of several nodes (a tablet's pad and pen, a keydial's two interfaces):
+    // the box plays the busiest one (its path in the replay is FILE#N).
+    auto recording = sim::readHidRecording(spec.trace);
+    if (!recording) return std::unexpected(recording.error());
+    if (recording->devices.size() > 1) {
+      const auto busiest = std::ranges::max_element(recording->devices, {},
+                                                    [](const sim::HidRecordedDevice& d) { return d.reports.size(); });
+      request.match.path = fmt::format("{}#{}", spec.trace.string(), busiest->index);
+    }
+  }
+  // The SGI box answers its reset within milliseconds; a retry with nothing on the port must not
+  // hold the frame loop for the backend's default second.
+  if (spec.backend == DeviceBackend::kSerial) request.options["reset_timeout_ms"] = "200";
   return makeMatchedDialBox(std::move(*provider), std::move(request), clock);
 }
 
@@ -316,8 +424,10 @@ Result<std::unique_ptr<devices::DeviceProvider>> providerFor(const DeviceSpec& s
     case DeviceBackend::kV4l2: return std::make_unique<devices::V4l2Provider>();
     case DeviceBackend::kLibcamera: return std::make_unique<devices::LibcameraProvider>();
     case DeviceBackend::kSynthetic: return std::make_unique<sim::SyntheticProvider>();
+    // The SGI box on the manifest's port (and any USB serial adapter; the match picks the port).
+    case DeviceBackend::kSerial: return std::make_unique<devices::SerialProvider>(std::vector{spec.match.path});
     case DeviceBackend::kReplay: {
-      auto replay = std::make_unique<sim::ReplayProvider>();
+      auto replay = std::make_unique<sim::ReplayProvider>(matroskaTraceReaderFactory());
       std::error_code ec;
       auto added = std::filesystem::is_directory(spec.trace, ec) ? replay->addTrace(spec.trace)
                                                                  : replay->addHidRecording(spec.trace);
@@ -352,6 +462,7 @@ void registerShowFactories() {
   std::call_once(once, [] {
     setDialBoxFactory(DeviceBackend::kHid, makeDialBoxFromSpec);
     setDialBoxFactory(DeviceBackend::kReplay, makeDialBoxFromSpec);
+    setDialBoxFactory(DeviceBackend::kSerial, makeDialBoxFromSpec);
     setStreamFactory(MediaKind::kMovie, makeMovieStream);
     setStreamFactory(MediaKind::kCamera, makeCameraStream);
   });

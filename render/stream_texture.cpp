@@ -128,7 +128,7 @@ void setSampling(GLenum filter) {
 /// The conversion program for one layout.
 struct ConversionProgram {
   gl::Program program;
-  GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1, chromaScale = -1;
+  GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1, chromaScale = -1, mirrorWidth = -1;
 };
 
 /// yuv.frag with LAYOUT defined: one program per layout, so no pixel runs a branch.
@@ -149,6 +149,7 @@ Result<ConversionProgram> buildConversion(int layout) {
   c.rect = glGetUniformLocation(p, "uRect");
   c.flip = glGetUniformLocation(p, "uFlipY");
   c.chromaScale = glGetUniformLocation(p, "uChromaScale");
+  c.mirrorWidth = glGetUniformLocation(p, "uMirrorWidth");
   glUseProgram(p);
   glUniform1i(glGetUniformLocation(p, "uPlane0"), 0);
   glUniform1i(glGetUniformLocation(p, "uPlane1"), 1);
@@ -395,6 +396,8 @@ Result<void> StreamTexture::convert(const Frame& frame) {
     glUniform2f(c.chromaScale, static_cast<float>(frame.width) / static_cast<float>(2 * cw),
                 static_cast<float>(frame.height) / static_cast<float>(2 * ch));
   }
+  // Mirrored: the target's left column is the frame's right one.
+  glUniform1i(c.mirrorWidth, mirror_ ? static_cast<GLint>(frame.width) : 0);
   // YV12 stores V before U: bind the planes so that unit 1 is always U.
   const bool swapUv = frame.format == PixelFormat::kYv12;
   for (int i = 0; i < 3; ++i) {
@@ -413,6 +416,12 @@ Result<void> StreamTexture::convert(const Frame& frame) {
   glUseProgram(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return {};
+}
+
+void StreamTexture::setMirror(bool mirror) {
+  if (mirror == mirror_) return;
+  mirror_ = mirror;
+  shown_ = nullptr;  // the frame on the texture is converted again, flipped or not
 }
 
 Result<bool> StreamTexture::update(const FrameRef& ref) {
@@ -437,7 +446,7 @@ Result<bool> StreamTexture::update(const FrameRef& ref) {
       dmabufOffered_ = false;
     }
   }
-  if (path == UploadPath::kPlanes && frame.format == PixelFormat::kRgba8) {
+  if (path == UploadPath::kPlanes && frame.format == PixelFormat::kRgba8 && !mirror_) {
     // Already what the renderer samples: straight into the target, no pass.
     if (auto r = uploadRgba(frame); !r) return std::unexpected(r.error());
   } else {
@@ -472,13 +481,14 @@ void StreamTexture::publish(TextureRegistry& registry) const { registry.setExter
 std::string StreamTexture::describe() const {
   if (path_ == UploadPath::kNone) return fmt::format("stream '{}': no frame yet (fallback shown)", name_);
   const bool yuv = isYuv(format_);
-  const std::string_view how = path_ == UploadPath::kPlanes && format_ == PixelFormat::kRgba8
+  const std::string_view how = path_ == UploadPath::kPlanes && format_ == PixelFormat::kRgba8 && !mirror_
                                    ? std::string_view("uploaded as is (already RGBA)")
                                    : uploadPathName(path_);
-  return fmt::format("stream '{}': {} {}x{}, {}{}", name_, pixelFormatName(format_), gpu_->width, gpu_->height, how,
+  return fmt::format("stream '{}': {} {}x{}, {}{}{}", name_, pixelFormatName(format_), gpu_->width, gpu_->height, how,
                      yuv ? fmt::format(" ({} {} range)", matrixName(colorimetry_),
                                        colorimetry_.range == Colorimetry::Range::kFull ? "full" : "limited")
-                         : std::string{});
+                         : std::string{},
+                     mirror_ ? ", mirrored" : "");
 }
 
 Result<void> StreamTexture::readPixels(Image& out) const {

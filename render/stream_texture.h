@@ -50,6 +50,11 @@ class StreamTexture {
   /// \brief The fallback colour (RGBA 0..1); default dark grey.
   void setFallbackColor(float r, float g, float b);
   [[nodiscard]] bool showingFallback() const { return fallback_; }
+  /// \brief Flips the picture left-right from the next frame on (a camera asked to mirror
+  /// that cannot flip in the device: VideoSource::mirrorInRenderer()). The frame on the texture
+  /// is converted again at its next update().
+  void setMirror(bool mirror);
+  [[nodiscard]] bool mirror() const { return mirror_; }
 
   /// \brief Registers (or refreshes) the texture under name() in `registry`.
   void publish(TextureRegistry& registry) const;
@@ -87,6 +92,7 @@ class StreamTexture {
   std::uint64_t conversions_ = 0;
   bool fallback_ = true;
   bool dmabufOffered_ = false;
+  bool mirror_ = false;
   float fallbackColor_[3] = {0.12f, 0.12f, 0.12f};
 };
 

@@ -82,6 +82,42 @@ Result<void> applyCameraOptions(const devices::DeviceRequest& request, Synthetic
   auto moving = boolOption(request, "moving", config.moving);
   if (!moving) return std::unexpected(moving.error());
   config.moving = *moving;
+  // "unplug@NS,signal_lost@NS+NS,stall@NS+NS": times in nanoseconds after opening.
+  const std::string faults = optionOr(request, "faults", "");
+  std::string_view rest = faults;
+  while (!rest.empty()) {
+    const auto comma = rest.find(',');
+    const std::string_view item = rest.substr(0, comma);
+    rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
+    const auto at = item.find('@');
+    const auto plus = item.find('+');
+    CameraFault f;
+    const std::string_view kind = item.substr(0, at);
+    const auto number = [](std::string_view text, std::int64_t& out) {
+      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
+      return ec == std::errc{} && end == text.data() + text.size() && out >= 0;
+    };
+    std::int64_t time = 0;
+    std::int64_t length = 0;
+    bool ok = at != std::string_view::npos;
+    if (kind == "unplug") {
+      f.kind = CameraFault::Kind::kUnplug;
+      ok = ok && plus == std::string_view::npos && number(item.substr(at + 1), time);
+    } else if (kind == "signal_lost" || kind == "stall") {
+      f.kind = kind == "stall" ? CameraFault::Kind::kStall : CameraFault::Kind::kSignalLost;
+      ok = ok && plus != std::string_view::npos && plus > at && number(item.substr(at + 1, plus - at - 1), time) &&
+           number(item.substr(plus + 1), length);
+    } else {
+      ok = false;
+    }
+    if (!ok) {
+      return fail(Errc::kInvalidArgument,
+                  fmt::format("fault '{}' is not unplug@NS, signal_lost@NS+NS or stall@NS+NS", item), where(request));
+    }
+    f.time = Nanos{time};
+    f.duration = Nanos{length};
+    config.faults.push_back(f);
+  }
   return {};
 }
 

@@ -25,7 +25,7 @@ namespace basalt::sim {
 ///
 /// Request options it reads: dial boxes `loop` (true/false); cameras `format` (YUYV, NV12,
 /// I420, RGBA, ...), `size` (WxH), `fps`, `pattern` (bars, gradient, checker, solid), `moving`
-/// (true/false).
+/// (true/false), `faults` (see applyCameraOptions).
 ///
 /// Tests plug and unplug devices with plug()/unplug(): an unplugged device's live object fails
 /// its next read, and a device plugged at the same path may be a different one.
@@ -70,7 +70,8 @@ class SyntheticProvider final : public devices::DeviceProvider {
   std::vector<Entry> entries_;  // guarded by mutex_
 };
 
-/// \brief Applies a camera request's options (format, size, fps, pattern, moving) to `config`.
+/// \brief Applies a camera request's options (format, size, fps, pattern, moving, faults:
+/// "unplug@NS,signal_lost@NS+NS,stall@NS+NS" in nanoseconds after opening) to `config`.
 [[nodiscard]] Result<void> applyCameraOptions(const devices::DeviceRequest& request, SyntheticCameraConfig& config);
 
 /// \brief The `replay` backend: the devices recorded in trace folders and hid-recorder files.

@@ -27,6 +27,8 @@ uniform vec3 uBias;
 // Chroma texture coordinates from luma ones: (width / (2 * chroma width), same for height), so
 // that a pixel's chroma sample is the one sited with its top-left luma sample, odd sizes too.
 uniform vec2 uChromaScale;
+// 0, or the frame's width to mirror it left-right (a camera that cannot flip in the device).
+uniform int uMirrorWidth;
 
 in vec2 vUv;
 out vec4 fragColor;
@@ -37,7 +39,11 @@ void main() {
   // The target has the frame's size: every sample is a texel fetch (no filtering), chroma at
   // half resolution: 4:2:0 chroma sited with its top-left luma sample.
   ivec2 px = ivec2(gl_FragCoord.xy);
-  ivec2 cx = px >> 1;  // a shift: software renderers cannot vectorise integer division
+  vec2 uv = vUv;
+  if (uMirrorWidth > 0) {
+    px.x = uMirrorWidth - 1 - px.x;
+    uv.x = 1.0 - uv.x;  // texel centres map onto texel centres
+  }
 #if LAYOUT == LAYOUT_RGBA
   fragColor = vec4(texelFetch(uPlane0, px, 0).rgb, 1.0);
 #elif LAYOUT == LAYOUT_BGRA
@@ -48,12 +54,12 @@ void main() {
   // Planar layouts sample with texture() at texel centres (nearest): the same texels as
   // texelFetch, but software renderers (llvmpipe) take their fast 8-bit path for it, which
   // costs about half as much per pixel as texelFetch's gather.
-  vec2 c = vUv * uChromaScale;
-  fragColor = vec4(toRgb(vec3(texture(uPlane0, vUv).r, texture(uPlane1, c).r, texture(uPlane2, c).r)), 1.0);
+  vec2 c = uv * uChromaScale;
+  fragColor = vec4(toRgb(vec3(texture(uPlane0, uv).r, texture(uPlane1, c).r, texture(uPlane2, c).r)), 1.0);
 #elif LAYOUT == LAYOUT_NV12
-  fragColor = vec4(toRgb(vec3(texture(uPlane0, vUv).r, texture(uPlane1, vUv * uChromaScale).rg)), 1.0);
+  fragColor = vec4(toRgb(vec3(texture(uPlane0, uv).r, texture(uPlane1, uv * uChromaScale).rg)), 1.0);
 #elif LAYOUT == LAYOUT_NV21
-  fragColor = vec4(toRgb(vec3(texture(uPlane0, vUv).r, texture(uPlane1, vUv * uChromaScale).gr)), 1.0);
+  fragColor = vec4(toRgb(vec3(texture(uPlane0, uv).r, texture(uPlane1, uv * uChromaScale).gr)), 1.0);
 #else
   vec4 t = texelFetch(uPlane0, ivec2(px.x >> 1, px.y), 0);
   bool odd = (px.x & 1) == 1;

@@ -1,10 +1,12 @@
 // `basalt devices`, `basalt record` and `basalt run --replay` as a user runs them: the device list
 // with the simulated twins and recordings, a demo trace recorded without hardware, and the same
 // trace under the same show giving the same frames bit for bit (and different frames from a show
-// without it, so the dials really drove the show).
+// without it, so the dials really drove the show); camera video recorded in Matroska by default,
+// as .bvraw with --raw-video, and both replay.
 // Example failures: `basalt devices` failing on a machine with nothing plugged in; a recording
 // that writes no trace.toml; a replay that depends on wall-clock timing and so renders
-// differently from run to run.
+// differently from run to run; a camera recorded in the old format only, or a .bvraw trace that no
+// longer replays.
 
 #include <gtest/gtest.h>
 
@@ -80,8 +82,12 @@ TEST(DevicesCli, RecordedTraceReplaysBitForBit) {
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_TRUE(std::filesystem::exists(trace / "trace.toml"));
   EXPECT_TRUE(std::filesystem::exists(trace / "dials.hid"));
-  EXPECT_TRUE(std::filesystem::exists(trace / "camera.bvraw"));
+  EXPECT_TRUE(std::filesystem::exists(trace / "camera.mkv")) << "camera video is recorded in Matroska";
   EXPECT_NE(r.output.find("recorded 2 device(s)"), std::string::npos) << r.output;
+  const auto raw = dir / "raw.trace";
+  r = runBasalt({"record", "--synthetic", "--fast", "--seconds", "1", "--raw-video", "--output", raw.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(raw / "camera.bvraw")) << "--raw-video keeps the uncompressed format";
   r = runBasalt({"record", "--synthetic", "--fast", "--seconds", "1", "--output", trace.string()});
   EXPECT_EQ(r.exitCode, 1) << "recording over a trace must be refused";
   EXPECT_NE(r.output.find("not empty"), std::string::npos) << r.output;
@@ -94,6 +100,8 @@ TEST(DevicesCli, RecordedTraceReplaysBitForBit) {
   EXPECT_NE(r.output.find("replayed dial box 'dials' (live)"), std::string::npos) << r.output;
   r = runBasalt({"run", "--frames", "90", "--headless", "--replay", trace.string(), "--snapshot", b.string()});
   ASSERT_EQ(r.exitCode, 0) << r.output;
+  r = runBasalt({"run", "--frames", "30", "--headless", "--replay", raw.string()});
+  EXPECT_EQ(r.exitCode, 0) << ".bvraw traces still replay: " << r.output;
   r = runBasalt({"run", "--frames", "90", "--headless", "--snapshot", plain.string()});
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const std::string pa = slurp(a), pb = slurp(b), pp = slurp(plain);

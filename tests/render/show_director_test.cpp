@@ -4,7 +4,8 @@
 // playlist; a visitor wakes the attract loop; items that cannot play (a scene with nothing to
 // show, a movie) are skipped, and when none can, the screen is black rather than stuck; scripts,
 // scenes and models play as items (a script that ends or quits moves the playlist on); control
-// commands run on the show; outside opening hours the display goes off
+// commands run on the show; a shuttle ring held off-centre turns the show frame after frame
+// until it is let go; outside opening hours the display goes off
 // (black where the output has no display to switch); a stream texture shows its fallback.
 // Example failures: a black frame while the new show loads; a reload error that stops the show;
 // a button that does nothing; an unplayable item retried every frame.
@@ -186,11 +187,16 @@ entry = "default"
 kind = "dial_box"
 backend = "synthetic"
 loop = false
-script = [ { at = "0.1s", dial = 1, turns = 0.25 }, { at = "0.2s", dial = 5, turns = 1.0 } ]
+script = [ { at = "0.1s", dial = 1, turns = 0.25 }, { at = "0.2s", dial = 5, turns = 1.0 },
+           { at = "0.2s", dial = 4, turns = 0.5 } ]
 [[bindings]]
 device = "dials"
 dial = 1
 action = "rotate_y"
+[[bindings]]
+device = "dials"
+dial = 5
+action = "none"
 )";
   Harness turned("dials");
   OPEN_OR_SKIP(turned);
@@ -207,11 +213,54 @@ action = "rotate_y"
   for (int i = 0; i < 16; ++i)
     difference += std::abs(a.m[static_cast<std::size_t>(i)] - b.m[static_cast<std::size_t>(i)]);
   EXPECT_GT(difference, 0.5f) << "the dial's quarter turn is in the show";
-  // Dial 5 (LAVA's translate Y) is not bound in this show, which binds dial 1 only: no move.
-  EXPECT_FLOAT_EQ(a.m[13], b.m[13]);
+  // Dial 4 keeps LAVA's translate X (bindings override one dial each), half a turn: half a
+  // window unit, rotated since by the free run; dial 5 is bound to nothing, so no Y on top.
+  const float moved = std::hypot(a.m[12], a.m[13], a.m[14]);
+  EXPECT_NEAR(moved, 0.5f, 1e-4f) << "dial 4 moved the show by LAVA's table and dial 5 did not";
+  EXPECT_FLOAT_EQ(std::hypot(b.m[12], b.m[13], b.m[14]), 0.0f);
   const StatusSnapshot s = turned.board().snapshot(WallTime{});
   ASSERT_EQ(s.devices.size(), 1u);
   EXPECT_EQ(s.devices[0].state, "live");
+}
+
+/// How far apart two shows' placements are (Frobenius norm of the difference): unchanged by the
+/// free-run rotation both shows go on to apply.
+float placementDistance(const runtime::Show& x, const runtime::Show& y) {
+  const Mat4& a = x.position().global;
+  const Mat4& b = y.position().global;
+  float sum = 0;
+  for (std::size_t i = 0; i < 16; ++i) sum += (a.m[i] - b.m[i]) * (a.m[i] - b.m[i]);
+  return std::sqrt(sum);
+}
+
+TEST(ShowDirector, AHeldShuttleRingKeepsTurningTheShowUntilReleased) {
+  // Dial 0 is LAVA's rotate X; its shuttle ring is held at half deflection from 0.1 s to 0.5 s.
+  const std::string manifest = R"(
+[show]
+entry = "default"
+[devices.shuttle]
+kind = "dial_box"
+backend = "synthetic"
+loop = false
+script = [ { at = "0.1s", shuttle = 0, position = 0.5 }, { at = "0.5s", shuttle = 0, position = 0 } ]
+)";
+  Harness held("shuttle");
+  OPEN_OR_SKIP(held);
+  ASSERT_TRUE(held.install(manifest));
+  Harness still("shuttle-still");
+  OPEN_OR_SKIP(still);
+  ASSERT_TRUE(still.install(kCube));
+  std::vector<float> distance;
+  for (int step = 0; step < 6; ++step) {  // 0.2, 0.4, 0.6, 0.8, 1.0, 1.2 s
+    held.run(6);
+    still.run(6);
+    distance.push_back(placementDistance(held.show(), still.show()));
+  }
+  EXPECT_GT(distance[0], 0.01f) << "the held ring turns the show";
+  EXPECT_GT(distance[1], distance[0] + 0.05f) << "and goes on turning it, frame after frame, while held";
+  EXPECT_NEAR(distance[3], distance[2], 1e-4f) << "a released ring stops turning the show";
+  EXPECT_NEAR(distance[5], distance[3], 1e-4f);
+  EXPECT_EQ(held.recorder().blackFrames(), 0u);
 }
 
 TEST(ShowDirector, ButtonsMoveThePlaylistAndInputWakesTheAttractLoop) {

@@ -5,28 +5,40 @@
 // replayed recording, shows the live camera; a replayed dial box turns the show through its
 // binding; a dial box that is not plugged in shows in the status with its reason and the show
 // goes on; the scripts' VCR loads, plays, pauses, steps and rewinds a real clip from
-// ../shared/testdata/video.
+// ../shared/testdata/video; a camera's on_loss picture (its last frame, a test pattern, a colour,
+// or the fallback image) shows while the synthetic camera is unplugged and the live picture
+// comes back with it; a camera asked to mirror that cannot flip is mirrored by the renderer;
+// `basalt record`'s Matroska camera video replays frame for frame, bit for bit, at the recorded
+// microsecond.
 // Example failures: a factory that is never registered (streams stay "absent"); a movie texture
 // that stays on its fallback; a replayed knob whose events never reach the bindings; a missing
-// device that crashes the show or is reported without its reason; a VCR command that is ignored.
+// device that crashes the show or is reported without its reason; a VCR command that is ignored;
+// a lost camera that shows the fallback image whatever on_loss says; a Matroska trace whose
+// frames come back shifted, re-encoded or at millisecond times.
 
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "kiosk/frame_loop.h"
 #include "kiosk/manifest.h"
+#include "kiosk/readers.h"
 #include "kiosk/script_player.h"
 #include "kiosk/show_director.h"
 #include "kiosk/show_loader.h"
 #include "kiosk/status_board.h"
 #include "kiosk/stream_factories.h"
+#include "kiosk/trace_video_glue.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/event_loop.h"
 #include "runtime/script/interpreter.h"
 #include "sim/providers.h"
+#include "sim/replay.h"
+#include "sim/synthetic_camera.h"
 #include "sim/trace.h"
 #include "support/test_paths.h"
 
@@ -74,6 +86,7 @@ class Harness {
   void run(std::int64_t frames) {
     FrameLoop loop({30, frames}, clock_, &clock_, *loop_, show_, *output_, *renderer_);
     loop.addParticipant(*director_);
+    loop.addParticipant(capture_);
     auto stats = loop.run();
     ASSERT_TRUE(stats) << stats.error().describe();
   }
@@ -92,6 +105,8 @@ class Harness {
   }
   StatusBoard& board() { return board_; }
   runtime::Show& show() { return show_; }
+  /// The last frame drawn, read back.
+  [[nodiscard]] const Image& lastFrame() const { return capture_.image; }
   ManualClock& clock() { return clock_; }
 
  private:
@@ -104,6 +119,12 @@ class Harness {
   BoundedQueue<Event> events_{1024};
   runtime::Show show_;
   std::unique_ptr<ShowDirector> director_;
+  struct Capture final : FrameParticipant {
+    Image image;
+    Result<void> afterDraw(const FrameContext& /*frame*/, render::Output& output) override {
+      return output.readBack(image);
+    }
+  } capture_;
 };
 
 #define OPEN_OR_SKIP(h)                                                  \
@@ -323,6 +344,226 @@ TEST(ShowStreams, TheScriptVcrDrivesARealClip) {
   EXPECT_GE(at[15], at[13] + 10) << "fast_forward does not go ten frames on";
   EXPECT_LE(at[17], 1) << "rewind does not go back to the start";
   EXPECT_FALSE(live.back()) << "after unload the video texture is gone";
+}
+
+/// Pixels of `image` that are orange (#ff8000 as lit on the sculpture): red well above green,
+/// green well above blue. Colour bars have no such colour (their red has no green, their
+/// yellow as much green as red).
+std::size_t orangePixels(const Image& image) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i + 3 < image.pixels.size(); i += 4) {
+    const int r = image.pixels[i], g = image.pixels[i + 1], b = image.pixels[i + 2];
+    if (g > 30 && r > g * 3 / 2 && g > b * 3 / 2 + 10) ++n;
+  }
+  return n;
+}
+
+/// The camera-sculpture example with a synthetic camera unplugged 0.4 s after each open, the
+/// camera's media showing `onLoss` while it is gone.
+::testing::AssertionResult installLossShow(Harness& h, const std::string& onLoss, bool mirror = false) {
+  registerContentReaders();  // the sculpture is a scene
+  const auto example = test::sourceDir() / "configs/shows/camera-sculpture";
+  for (const char* file : {"sculpture.sce", "sculpture.obj", "camera.png"}) {
+    std::filesystem::copy_file(example / file, h.dir() / file, std::filesystem::copy_options::overwrite_existing);
+  }
+  std::ofstream(h.dir() / "show.toml") << fmt::format(R"(
+[show]
+entry = "sculpture.sce"
+[devices.camera]
+kind = "camera"
+backend = "synthetic"
+size = "160x120"
+mirror = {}
+faults = [ {{ at = "0.4s", fault = "unplug" }} ]
+[media.live]
+kind = "camera"
+device = "camera"
+{}
+[textures."camera.png"]
+source = "live"
+fallback = "camera.png"
+)",
+                                                      mirror ? "true" : "false",
+                                                      onLoss.empty() ? "" : "on_loss = \"" + onLoss + "\"");
+  return h.install(h.dir() / "show.toml");
+}
+
+/// Runs frame by frame until `done` (at most `limit` frames); whether it came.
+template <typename Done>
+bool runUntil(Harness& h, Done done, int limit = 60) {
+  for (int i = 0; i < limit; ++i) {
+    if (done()) return true;
+    h.run(2);  // a run's first frame is at the time the last one ended: one frame interval on
+  }
+  return done();
+}
+
+bool says(const LoadedTexture& t, const std::string& text) {
+  return t.stream->describe().find(text) != std::string::npos;
+}
+
+TEST(ShowStreams, ALostCameraShowsItsOnLossColourAndComesBack) {
+  Harness h("loss-colour");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(installLossShow(h, "#ff8000"));
+  const LoadedTexture* camera = h.texture("camera.png");
+  ASSERT_NE(camera, nullptr);
+  ASSERT_NE(camera->stream, nullptr) << camera->streamState;
+  h.run(9);  // 0.3 s: live
+  ASSERT_TRUE(camera->live) << camera->stream->describe();
+  EXPECT_GT(std::count_if(h.lastFrame().pixels.begin(), h.lastFrame().pixels.end(), [](auto v) { return v > 40; }),
+            1000)
+      << "the sculpture shows the camera";
+  EXPECT_EQ(orangePixels(h.lastFrame()), 0u);
+  // Unplugged 0.4 s after it opened; reopened after the manager's back-off.
+  ASSERT_TRUE(runUntil(h, [&] { return says(*camera, "; showing"); })) << camera->stream->describe();
+  h.run(1);
+  EXPECT_TRUE(camera->live) << "the colour is what the texture shows: " << camera->stream->describe();
+  EXPECT_TRUE(says(*camera, "showing #ff8000")) << camera->stream->describe();
+  EXPECT_GT(orangePixels(h.lastFrame()), 50u) << "the sculpture shows the on_loss colour";
+  ASSERT_TRUE(runUntil(h, [&] { return !says(*camera, "showing"); })) << camera->stream->describe();
+  h.run(2);
+  EXPECT_TRUE(camera->live);
+  EXPECT_EQ(orangePixels(h.lastFrame()), 0u) << "the live picture replaced the colour";
+}
+
+TEST(ShowStreams, EveryOnLossKindShowsWhileTheCameraIsGone) {
+  struct Case {
+    std::string onLoss;
+    bool liveWhileLost;  // the stream keeps the texture (else the director shows the fallback image)
+    std::string says;
+  };
+  for (const Case& c : {Case{"", false, "the texture's fallback image"}, Case{"fallback", false, "fallback image"},
+                        Case{"last_frame", true, "its last frame"}, Case{"test_pattern", true, "a test pattern"}}) {
+    SCOPED_TRACE(c.onLoss);
+    Harness h("loss-" + (c.onLoss.empty() ? std::string("default") : c.onLoss));
+    OPEN_OR_SKIP(h);
+    ASSERT_TRUE(installLossShow(h, c.onLoss));
+    const LoadedTexture* camera = h.texture("camera.png");
+    ASSERT_NE(camera, nullptr);
+    ASSERT_NE(camera->stream, nullptr) << camera->streamState;
+    h.run(9);
+    ASSERT_TRUE(camera->live) << camera->stream->describe();
+    const Image live = h.lastFrame();
+    ASSERT_TRUE(runUntil(h, [&] { return says(*camera, "; showing"); })) << camera->stream->describe();
+    const Image before = h.lastFrame();  // the frame in which the loss was noticed
+    h.run(2);
+    EXPECT_EQ(camera->live, c.liveWhileLost) << camera->stream->describe();
+    EXPECT_TRUE(says(*camera, c.says)) << camera->stream->describe();
+    if (c.onLoss == "last_frame") {
+      EXPECT_EQ(h.lastFrame().pixels, before.pixels) << "the last frame stays while the camera is gone";
+    } else if (c.onLoss == "test_pattern") {
+      EXPECT_NE(h.lastFrame().pixels, live.pixels) << "colour bars replaced the camera's picture";
+    }
+    ASSERT_TRUE(runUntil(h, [&] { return !says(*camera, "; showing") && camera->live; }))
+        << "the camera came back: " << camera->stream->describe();
+  }
+}
+
+TEST(ShowStreams, ACameraThatCannotFlipIsMirroredByTheRenderer) {
+  Harness plain("mirror-off");
+  OPEN_OR_SKIP(plain);
+  ASSERT_TRUE(installLossShow(plain, "", false));
+  Harness mirrored("mirror-on");
+  OPEN_OR_SKIP(mirrored);
+  ASSERT_TRUE(installLossShow(mirrored, "", true));
+  plain.run(6);
+  mirrored.run(6);
+  const LoadedTexture* camera = mirrored.texture("camera.png");
+  ASSERT_TRUE(camera && camera->live);
+  EXPECT_NE(camera->stream->describe().find("mirrored by the renderer"), std::string::npos)
+      << "the synthetic camera has no hardware flip: " << camera->stream->describe();
+  EXPECT_EQ(plain.texture("camera.png")->stream->describe().find("mirrored"), std::string::npos);
+  EXPECT_NE(plain.lastFrame().pixels, mirrored.lastFrame().pixels) << "the sculpture shows the picture flipped";
+}
+
+TEST(ShowStreams, MatroskaTracesReplayTheRecordedFramesAtTheirMicrosecond) {
+  // Record the synthetic camera (YUYV 160x90, 30 fps, moving box) into a trace as `basalt
+  // record` does, through the kiosk's Matroska writer.
+  const auto dir = test::scratchDir("streams-mkv-trace");
+  const auto folder = dir / "cam.trace";
+  std::filesystem::remove_all(folder);
+  ManualClock clock(Nanos{std::chrono::seconds(10)});
+  BoundedQueue<Event> events(64);
+  std::vector<std::vector<std::uint8_t>> recorded;
+  std::vector<Nanos> recordedTimes;
+  {
+    devices::DeviceManager manager(clock, events);
+    manager.addProvider(std::make_unique<sim::SyntheticProvider>());
+    devices::DeviceRequest request{"cam", devices::DeviceKind::kVideoSource, {}, {}, {}};
+    request.match.backend = "synthetic";
+    request.options = {{"size", "160x90"}, {"fps", "30"}};
+    auto id = manager.request(request);
+    ASSERT_TRUE(id) << id.error().describe();
+    auto recorder =
+        sim::TraceRecorder::create(folder, clock, {"test-host", "basalt-test", 30, matroskaTraceWriterFactory()});
+    ASSERT_TRUE(recorder) << recorder.error().describe();
+    manager.setTaps(nullptr, recorder->get());
+    manager.step(clock.now());
+    auto stream = manager.videoStream("cam");
+    ASSERT_TRUE(stream);
+    for (const devices::DeviceStatus& st : manager.status()) {
+      ASSERT_TRUE((*recorder)->addVideoSource(*id, "cam", st.device, st.mode.value_or(devices::VideoMode{})));
+    }
+    for (int frame = 0; frame < 20; ++frame) {
+      clock.advance(fromSeconds(1.0 / 30));
+      manager.step(clock.now());
+      (*recorder)->drain();
+      const FrameRef f = stream->frameAt(clock.now());
+      if (f && (recordedTimes.empty() || f->pts != recordedTimes.back())) {
+        recorded.emplace_back(f->planes[0].data, f->planes[0].data + f->planes[0].size);
+        recordedTimes.push_back(f->pts);
+      }
+    }
+    manager.setTaps(nullptr, nullptr);
+    auto info = (*recorder)->finish();
+    ASSERT_TRUE(info) << info.error().describe();
+    ASSERT_EQ(info->devices.size(), 1u);
+    EXPECT_EQ(info->devices[0].file, "cam.mkv");
+  }
+  ASSERT_GE(recorded.size(), 15u);
+  // Replay it as the manifests and `basalt run --replay` do: media's reader behind the replay
+  // provider. Every frame comes back byte for byte, at the recorded time after the replay's start.
+  sim::ReplayProvider provider(matroskaTraceReaderFactory());
+  ASSERT_TRUE(provider.addTrace(folder));
+  const auto candidates = provider.enumerate();
+  ASSERT_EQ(candidates.size(), 1u);
+  ManualClock replayClock(Nanos{std::chrono::seconds(100)});
+  devices::DeviceRequest replayRequest{"cam", devices::DeviceKind::kVideoSource, {}, {{"loop", "false"}}, {}};
+  auto camera = provider.openVideoSource(candidates[0], replayRequest, replayClock);
+  ASSERT_TRUE(camera) << camera.error().describe();
+  ASSERT_TRUE((*camera)->open(1));
+  EXPECT_EQ((*camera)->mode().format, PixelFormat::kYuyv);
+  EXPECT_NEAR((*camera)->mode().fps, 30, 0.01);
+  // Recorded frame k was captured at recordedTimes[k]; the trace started at 10 s. Matroska keeps
+  // the time since then to the microsecond.
+  std::map<Nanos, std::size_t> byTime;
+  for (std::size_t k = 0; k < recorded.size(); ++k) {
+    byTime[std::chrono::round<std::chrono::microseconds>(recordedTimes[k] - std::chrono::seconds(10))] = k;
+  }
+  const Nanos start = replayClock.now();
+  std::set<std::size_t> matched;
+  std::size_t replayed = 0;
+  Nanos lastPts{-1};
+  for (int i = 0; i < 80; ++i) {  // twice the frame rate: frames due a microsecond late are seen too
+    (*camera)->service(replayClock.now());
+    const FrameRef f = (*camera)->frameAt(replayClock.now());
+    if (f && f->pts != lastPts) {
+      lastPts = f->pts;
+      ++replayed;
+      const auto it = byTime.find(f->pts - start);
+      if (it != byTime.end()) {
+        const Plane& p = f->planes[0];
+        EXPECT_EQ(std::vector<std::uint8_t>(p.data, p.data + p.size), recorded[it->second])
+            << "frame " << it->second << " is the recorded one, byte for byte";
+        matched.insert(it->second);
+      }
+    }
+    replayClock.advance(fromSeconds(1.0 / 60));
+  }
+  const std::size_t got = matched.size();
+  EXPECT_GE(replayed, got);
+  EXPECT_GE(got, recorded.size() - 2) << "the replay showed the recorded frames at their recorded times";
 }
 
 }  // namespace

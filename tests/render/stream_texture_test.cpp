@@ -2,10 +2,12 @@
 // and cameras produce (I420, YV12, NV12, NV21, YUYV, UYVY, RGBA, BGRA, GRAY8) is uploaded as
 // planes and converted in the shader with the stream's colorimetry (BT.601/709/2020, limited and
 // full range) to the right colours; a frame is converted once however often it is offered; the
-// fallback shows when a source fails; the dmabuf path says why it is not taken here.
+// fallback shows when a source fails; the dmabuf path says why it is not taken here; a
+// mirrored stream (a camera that cannot flip in the device) shows every layout right to left.
 // Example failures: U and V swapped (YV12, NV21), a wrong matrix (BT.601 used for HD), limited
 // range shown as full (washed-out black), odd strides shearing the picture, packed 4:2:2
-// showing every pixel twice, a conversion per part instead of per frame.
+// showing every pixel twice, a conversion per part instead of per frame, a mirror that swaps the
+// two pixels of a packed 4:2:2 texel wrongly or is ignored for RGBA.
 
 #include <gtest/gtest.h>
 
@@ -148,6 +150,33 @@ TEST_P(StreamLayouts, ConvertsToTheRightColours) {
       EXPECT_NEAR(out.at(x, y, 2), wb * 255, 3) << "band " << band << " row " << y << " blue";
     }
   }
+}
+
+TEST_P(StreamLayouts, AMirroredStreamShowsTheBandsRightToLeft) {
+  const LayoutCase& c = GetParam();
+  std::shared_ptr<FramePool> pool;
+  FrameRef frame = bandFrame(c.format, c.colorimetry, pool);
+  stream_->setMirror(true);
+  ASSERT_TRUE(stream_->update(frame));
+  EXPECT_NE(stream_->describe().find("mirrored"), std::string::npos) << stream_->describe();
+  Image out;
+  ASSERT_TRUE(stream_->readPixels(out));
+  const bool gray = c.format == PixelFormat::kGray8;
+  for (std::size_t band = 0; band < kBands.size(); ++band) {
+    const auto x = static_cast<std::uint32_t>(band * kWidth / 4 + kWidth / 8);
+    const Rgb want = kBands[kBands.size() - 1 - band];
+    EXPECT_NEAR(out.at(x, kHeight / 2, 0), (gray ? want.g : want.r) * 255, 3) << "band " << band;
+    EXPECT_NEAR(out.at(x, kHeight / 2, 1), want.g * 255, 3) << "band " << band;
+    EXPECT_NEAR(out.at(x, kHeight / 2, 2), (gray ? want.g : want.b) * 255, 3) << "band " << band;
+  }
+  // The edge columns swap exactly (no half-pixel shift): column 0 shows the frame's last one.
+  EXPECT_NEAR(out.at(0, 1, 1), kBands.back().g * 255, 3);
+  // Mirror off again: the same frame is converted again, the right way round.
+  stream_->setMirror(false);
+  ASSERT_TRUE(stream_->update(frame));
+  EXPECT_EQ(stream_->conversions(), 2u);
+  ASSERT_TRUE(stream_->readPixels(out));
+  EXPECT_NEAR(out.at(kWidth / 8, kHeight / 2, 1), kBands.front().g * 255, 3);
 }
 
 constexpr Colorimetry k601Limited{Colorimetry::Matrix::kBt601, Colorimetry::Range::kLimited};

@@ -7,13 +7,19 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <fstream>
 #include <string>
+#include <thread>
 
 #include "kiosk/check_command.h"
 #include "kiosk/manifest.h"
+#include "kiosk/show_loader.h"
+#include "kiosk/stream_factories.h"
+#include "runtime/unique_fd.h"
 #include "support/process.h"
 #include "support/test_paths.h"
 
@@ -273,7 +279,7 @@ TEST(ManifestErrors, DevicesAreCoherent) {
   EXPECT_TRUE(hasError(r, 9, "'77d:410' is not VVVV:PPPP")) << r.text;
   EXPECT_TRUE(hasError(r, 10, "the replay backend needs trace")) << r.text;
   EXPECT_TRUE(hasError(r, 16, "has no trace.toml")) << r.text;
-  EXPECT_TRUE(hasError(r, 19, "'bluetooth' is not one of hid, v4l2, libcamera, replay or synthetic")) << r.text;
+  EXPECT_TRUE(hasError(r, 19, "'bluetooth' is not one of hid, serial, v4l2, libcamera, replay or synthetic")) << r.text;
   const auto ok = f.read("[devices.d]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"site.trace\"\n");
   ASSERT_TRUE(ok.manifest) << ok.text;
   EXPECT_EQ(ok.manifest->devices[0].trace, fs::canonical(f.dir / "site.trace"));
@@ -291,8 +297,24 @@ TEST(ManifestErrors, SyntheticScriptsAreChecked) {
       "]\n");
   EXPECT_TRUE(hasError(r, 6, "times must not go backwards")) << r.text;
   EXPECT_TRUE(hasError(r, 7, "dial: 9 is out of range; use 0 to 7")) << r.text;
-  EXPECT_TRUE(hasError(r, 8, "give either dial = N with turns, or button = N with pressed")) << r.text;
+  EXPECT_TRUE(hasError(r, 8, "give one of dial = N with turns, button = N with pressed, or shuttle = N")) << r.text;
   EXPECT_TRUE(hasError(r, 9, "'soon' is not a duration")) << r.text;
+  const auto shuttle = f.read(
+      "[devices.s]\nkind = \"dial_box\"\nbackend = \"synthetic\"\nscript = [\n"
+      "  { at = \"1s\", shuttle = 0, position = 0.5 },\n"  // 5
+      "  { at = \"2s\", shuttle = 0, position = 2 },\n"    // 6
+      "  { at = \"3s\", shuttle = 0 },\n"                  // 7
+      "]\n");
+  EXPECT_TRUE(hasError(shuttle, 6, "position: 2 is out of range")) << shuttle.text;
+  EXPECT_TRUE(hasError(shuttle, 7, "needs position = N")) << shuttle.text;
+  const auto held = f.read(
+      "[devices.s]\nkind = \"dial_box\"\nbackend = \"synthetic\"\n"
+      "script = [ { at = \"1s\", shuttle = 1, position = -0.5 } ]\n");
+  ASSERT_TRUE(held.manifest) << held.text;
+  ASSERT_EQ(held.manifest->devices[0].script.size(), 1u);
+  EXPECT_TRUE(held.manifest->devices[0].script[0].shuttle);
+  EXPECT_EQ(held.manifest->devices[0].script[0].index, 1);
+  EXPECT_DOUBLE_EQ(held.manifest->devices[0].script[0].value, -0.5);
 }
 
 TEST(ManifestErrors, BindingsNeedADialBoxThatExists) {
@@ -315,6 +337,61 @@ TEST(ManifestErrors, BindingsNeedADialBoxThatExists) {
   EXPECT_TRUE(hasError(r, 27, "dial 2 of 'dials' is already bound")) << r.text;
   EXPECT_TRUE(hasError(r, 34, "'rotate_z' is not one of none, next, previous or reset_view")) << r.text;
   EXPECT_TRUE(hasError(r, 35, "give either dial = N or button = N")) << r.text;
+}
+
+TEST(ManifestErrors, GainAccelerationAndOverridesAreChecked) {
+  ShowFolder f("gain");
+  const auto r = f.read(
+      "[devices.cam]\nkind = \"camera\"\nbackend = \"synthetic\"\ngain = 2\n"               // 1-4
+      "[devices.dials]\nkind = \"dial_box\"\nbackend = \"synthetic\"\nacceleration = -1\n"  // 5-8
+      "[[bindings]]\ndevice = \"dials\"\ndial = 3\nacceleration = \"fast\"\n"               // 9-12
+      "[[bindings]]\ndevice = \"dials\"\nbutton = 1\naction = \"next\"\ninvert = true\n"    // 13-17
+      "[[bindings]]\ndevice = \"dials\"\ndial = 7\ngain = 3\n"                              // 18-21
+      "[[bindings]]\ndevice = \"dials\"\nbutton = 2\n");                                    // 22-24
+  EXPECT_TRUE(hasWarning(r, 4, "devices.cam.gain: only dial boxes have one")) << r.text;
+  EXPECT_TRUE(hasError(r, 8, "acceleration: -1 is out of range")) << r.text;
+  EXPECT_TRUE(hasError(r, 12, "acceleration: must be a number")) << r.text;
+  EXPECT_TRUE(hasWarning(r, 17, "bindings[1].invert: buttons have no invert")) << r.text;
+  EXPECT_TRUE(hasWarning(r, 18, "dial 7 does nothing, so its gain")) << r.text;
+  EXPECT_TRUE(hasError(r, 22, "bindings[3]: needs action")) << r.text;
+}
+
+TEST(ManifestBindings, OverridesChangeOneDialOfLavasTable) {
+  ShowFolder f("overrides");
+  const auto r = f.read(
+      "[devices.dials]\nkind = \"dial_box\"\nbackend = \"hid\"\ngain = 0.5\nacceleration = 2\n"
+      "[[bindings]]\ndevice = \"dials\"\ndial = 1\naction = \"scale\"\n"
+      "[[bindings]]\ndevice = \"dials\"\ndial = 4\ngain = 3\nacceleration = 0\ninvert = true\n"
+      "[[bindings]]\ndevice = \"dials\"\ndial = 9\naction = \"rotate_z\"\ngain = 90\n"
+      "[[bindings]]\ndevice = \"dials\"\nbutton = 0\naction = \"reset_view\"\n");
+  ASSERT_TRUE(r.manifest) << r.text;
+  ManualClock clock;
+  auto loaded = loadShow(*r.manifest, clock, false);
+  ASSERT_TRUE(loaded) << loaded.error().describe();
+  ASSERT_EQ((*loaded)->devices.size(), 1u);
+  const runtime::Bindings& b = (*loaded)->devices[0].dials;
+  EXPECT_DOUBLE_EQ(b.gain(), 0.5) << "the device's gain multiplies every dial";
+  // Dials no binding names keep LAVA's action and gain, with the device's acceleration.
+  EXPECT_EQ(b.dial(0), (runtime::DialBinding{runtime::Action::kRotateX, 360, 2, false}));
+  EXPECT_EQ(b.dial(2), (runtime::DialBinding{runtime::Action::kRotateZ, 360, 2, false}));
+  EXPECT_EQ(b.dial(5), (runtime::DialBinding{runtime::Action::kTranslateY, 1, 2, false}));
+  EXPECT_EQ(b.dial(6), (runtime::DialBinding{runtime::Action::kTranslateZ, 1, 2, false}));
+  // A new action with its default gain; LAVA's action with a new gain, acceleration, direction.
+  EXPECT_EQ(b.dial(1), (runtime::DialBinding{runtime::Action::kScale, 1, 2, false}));
+  EXPECT_EQ(b.dial(4), (runtime::DialBinding{runtime::Action::kTranslateX, 3, 0, true}));
+  // A dial beyond LAVA's eight.
+  EXPECT_EQ(b.dial(9), (runtime::DialBinding{runtime::Action::kRotateZ, 90, 2, false}));
+  EXPECT_EQ((*loaded)->devices[0].buttons[0], KioskAction::kResetView);
+
+  // Without bindings or device keys: exactly LAVA's table.
+  const auto plain = f.read("[devices.dials]\nkind = \"dial_box\"\nbackend = \"synthetic\"\n");
+  ASSERT_TRUE(plain.manifest) << plain.text;
+  auto lava = loadShow(*plain.manifest, clock, false);
+  ASSERT_TRUE(lava) << lava.error().describe();
+  const runtime::Bindings expected = runtime::Bindings::lavaDefaults();
+  for (std::size_t i = 0; i < runtime::kMaxBoundDials; ++i)
+    EXPECT_EQ((*lava)->devices[0].dials.dial(i), expected.dial(i));
+  EXPECT_DOUBLE_EQ((*lava)->devices[0].dials.gain(), 1);
 }
 
 TEST(ManifestErrors, MediaAndTextures) {
@@ -487,6 +564,112 @@ TEST(ManifestValues, TimeRangesDatesAndModes) {
   EXPECT_DOUBLE_EQ(mode->refresh, 60);
   EXPECT_FALSE(parseMode("1920x"));
   EXPECT_FALSE(parseMode("0x10"));
+}
+
+// ---- Dial boxes a manifest names ------------------------------------------------------------
+
+TEST(ManifestDevices, TheSerialBackendNeedsAPort) {
+  ShowFolder f("serial-errors");
+  const auto r = f.read(
+      "[devices.a]\nkind = \"dial_box\"\nbackend = \"serial\"\n"                                    // 1-3
+      "[devices.b]\nkind = \"camera\"\nbackend = \"serial\"\n"                                      // 4-6
+      "[devices.c]\nkind = \"dial_box\"\nbackend = \"serial\"\nmatch = { path = \"usb:1-2\" }\n");  // 7-10
+  EXPECT_TRUE(hasError(r, 1, "the serial backend needs the port: match = { path = \"/dev/ttyUSB0\" }")) << r.text;
+  EXPECT_TRUE(hasError(r, 6, "a camera cannot use the serial backend")) << r.text;
+  EXPECT_TRUE(hasError(r, 10, "'usb:1-2': the serial backend needs a /dev node")) << r.text;
+}
+
+TEST(ManifestDevices, TheSgiSerialBoxOpensOnItsPortAndTurnsItsDials) {
+  UniqueFd master(::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC));
+  if (!master || ::grantpt(master.get()) != 0 || ::unlockpt(master.get()) != 0) {
+    GTEST_SKIP() << "no pseudo-terminals here (/dev/ptmx)";
+  }
+  const std::string port = ::ptsname(master.get());
+  ShowFolder f("serial");
+  const auto r =
+      f.read("[devices.sgi]\nkind = \"dial_box\"\nbackend = \"serial\"\nmatch = { path = \"" + port + "\" }\n");
+  ASSERT_TRUE(r.manifest) << r.text;
+  EXPECT_EQ(r.manifest->devices[0].backend, DeviceBackend::kSerial);
+  registerShowFactories();
+  ManualClock clock;
+  auto loaded = loadShow(*r.manifest, clock, false);
+  ASSERT_TRUE(loaded) << loaded.error().describe();
+  DeviceSlot& slot = (*loaded)->devices[0];
+  ASSERT_TRUE(slot.dialBox) << slot.unavailable;
+  // The box answers the reset (0x20) as the real one does.
+  std::thread answer([&] {
+    pollfd p{master.get(), POLLIN, 0};
+    if (::poll(&p, 1, 3000) > 0) {
+      std::uint8_t b[16];
+      (void)!::read(master.get(), b, sizeof b);
+      const std::uint8_t ok = 0x20;
+      (void)!::write(master.get(), &ok, 1);
+    }
+  });
+  BoundedQueue<Event> events(64);
+  auto opened = slot.dialBox->open(1, events);
+  answer.join();
+  ASSERT_TRUE(opened) << opened.error().describe();
+  EXPECT_EQ(slot.dialBox->info().path, port);
+  const std::uint8_t turn[] = {0x33, 0x00, 0x32};  // dial 3 to count 50: a quarter turn
+  ASSERT_EQ(::write(master.get(), turn, 3), 3);
+  Event e;
+  bool got = false;
+  for (int i = 0; i < 400 && !got; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    slot.dialBox->service(clock.now());
+    while (events.pop(e)) {
+      if (e.kind == EventKind::kDialDelta) got = true;
+      if (got) break;
+    }
+  }
+  ASSERT_TRUE(got) << "the turn reached the show's event queue";
+  EXPECT_EQ(e.index, 3);
+  EXPECT_DOUBLE_EQ(e.value, 0.25);
+  // LAVA's table: dial 3 scales.
+  EXPECT_EQ(slot.dials.dial(3).action, runtime::Action::kScale);
+  slot.dialBox->close();
+}
+
+TEST(ManifestDevices, AHidRecorderFileReplaysAsADialBox) {
+  const fs::path file = test::testdataDir() / "hid" / "udev-hid-bpf" / "huion_keydial_mini050_bluetooth.hid";
+  if (test::testdataDir().empty() || !fs::exists(file)) GTEST_SKIP() << "../shared/testdata/hid is missing";
+  ShowFolder f("hid-recorder");
+  fs::copy_file(file, f.dir / "keydial.hid", fs::copy_options::overwrite_existing);
+  writeFile(f.dir / "notes.hid", "this is not a recording\n");
+  const auto bad = f.read(
+      "[devices.a]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"notes.hid\"\n"    // 1-4
+      "[devices.b]\nkind = \"camera\"\nbackend = \"replay\"\ntrace = \"keydial.hid\"\n");  // 5-8
+  EXPECT_TRUE(hasError(bad, 4, "'notes.hid' is not a hid-recorder file")) << bad.text;
+  EXPECT_TRUE(hasError(bad, 8, "a camera replays a NAME.trace folder")) << bad.text;
+
+  const auto r =
+      f.read("[devices.keydial]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"keydial.hid\"\nloop = false\n");
+  ASSERT_TRUE(r.manifest) << r.text;
+  registerShowFactories();
+  ManualClock clock;
+  auto loaded = loadShow(*r.manifest, clock, false);
+  ASSERT_TRUE(loaded) << loaded.error().describe();
+  DeviceSlot& slot = (*loaded)->devices[0];
+  ASSERT_TRUE(slot.dialBox) << slot.unavailable;
+  BoundedQueue<Event> events(64);
+  auto opened = slot.dialBox->open(1, events);
+  ASSERT_TRUE(opened) << opened.error().describe();
+  EXPECT_EQ(slot.dialBox->info().vendor, 0x256c) << "the Huion keydial of the recording";
+  // The recording's dial turn comes at 64.86 s after the start, on the show's clock.
+  std::vector<Event> got;
+  for (int i = 0; i < 700; ++i) {
+    clock.advance(std::chrono::milliseconds(100));
+    slot.dialBox->service(clock.now());
+    Event e;
+    while (events.pop(e)) {
+      if (e.kind != EventKind::kDeviceState) got.push_back(e);
+    }
+  }
+  ASSERT_FALSE(got.empty()) << "the recording's reports came out as events";
+  EXPECT_EQ(got[0].kind, EventKind::kDialDelta);
+  EXPECT_EQ(got[0].time, Nanos{64'859'915'000});
+  slot.dialBox->close();
 }
 
 }  // namespace
