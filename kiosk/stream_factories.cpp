@@ -1,5 +1,6 @@
 #include "kiosk/stream_factories.h"
 
+#include "kiosk/movie_item.h"
 #include "kiosk/script_player.h"
 
 #include <atomic>
@@ -354,6 +355,7 @@ void registerShowFactories() {
     setDialBoxFactory(DeviceBackend::kReplay, makeDialBoxFromSpec);
     setStreamFactory(MediaKind::kMovie, makeMovieStream);
     setStreamFactory(MediaKind::kCamera, makeCameraStream);
+    setItemFactory(EntryKind::kMovie, makeMovieItem);
   });
 }
 

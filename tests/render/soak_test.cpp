@@ -1,14 +1,15 @@
-// A day of unattended running in seconds: the default show in a playlist with the
-// attract loop, opening hours and idle time-outs, a dial box playing a looping trace of a
-// visitor's turns and presses, a movie texture (whose stream this build lacks, so its fallback
-// path runs), crash-recovery saves, and the status server asked for /health, /metrics and
-// /snapshot.png every simulated hour; 24 hours on a ManualClock at one frame per 10 s of show
-// time (43,200 frames). Resident memory and open file descriptors are sampled every hour and must
-// stay flat once the day's first opening (08:00) has drawn the cube and filled the caches.
-// The dial trace is the synthetic twin's looping script (the replay backend of recorded traces
-// is not on this branch); the movie part is only the stream-absent path for the same reason.
+// A day of unattended running in seconds: the default show in a playlist with the attract
+// loop, opening hours and idle time-outs; a dial box replaying a real recording (the Huion
+// Keydial mini's knob and play/pause key from ../shared/testdata/hid, put in a trace folder by
+// the test and looped); a real movie (a Motion-JPEG clip the test records with media's recorder)
+// looping on a texture all day and playing as a playlist item; crash-recovery saves; and the
+// status server asked for /health, /metrics, / and /snapshot.png every simulated hour. 24 hours
+// on a ManualClock at one frame per 2 s of show time (43,200 frames). Resident memory and open
+// file descriptors are sampled every hour and must stay flat once the day's first opening
+// (08:00) has drawn the cube and filled the caches.
 // Example failures: a string or vector that grows with every item change or every request; a
-// state file or socket descriptor opened per save or per request and never closed.
+// state file or socket descriptor opened per save or per request and never closed; a GStreamer
+// pipeline, buffer or texture leaked per loop of the movie or per start of the movie item.
 
 #include <gtest/gtest.h>
 
@@ -28,7 +29,9 @@
 #include "kiosk/state_store.h"
 #include "kiosk/status_board.h"
 #include "kiosk/status_server.h"
+#include "kiosk/stream_factories.h"
 #include "kiosk/time_zone.h"
+#include "media/recorder.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/event_loop.h"
@@ -70,7 +73,10 @@ class ModeWatcher final : public FrameParticipant {
   explicit ModeWatcher(const ShowDirector& director) : director_(director) {}
   void afterPresent(const FrameContext& /*frame*/) override {
     seen_[static_cast<std::size_t>(director_.policy()->current().mode)] = true;
+    const auto* item = director_.policy()->current().item;
+    if (item && item->name == "clip") playedClip_ = true;
   }
+  [[nodiscard]] bool playedClip() const { return playedClip_; }
   [[nodiscard]] std::set<std::string> seen() const {
     std::set<std::string> out;
     for (std::size_t i = 0; i < seen_.size(); ++i) {
@@ -82,17 +88,75 @@ class ModeWatcher final : public FrameParticipant {
  private:
   const ShowDirector& director_;
   std::array<bool, 3> seen_{};
+  bool playedClip_ = false;
 };
+
+/// A trace folder replaying the Huion Keydial mini recording's second device (D:1, the one that
+/// sends: its knob arrives as a mouse wheel, its key as Consumer Play/Pause).
+bool writeKeydialTrace(const std::filesystem::path& folder, std::string& why) {
+  const std::filesystem::path source = test::testdataDir() / "hid/udev-hid-bpf/huion_keydial_mini050_bluetooth.hid";
+  std::ifstream in(source);
+  if (!in) {
+    why = "no " + source.string() + " (../shared/testdata is not here)";
+    return false;
+  }
+  std::filesystem::create_directories(folder);
+  std::ofstream hid(folder / "dials.hid");
+  std::string line;
+  bool second = false;
+  while (std::getline(in, line)) {
+    if (line.starts_with("D:")) second = line == "D:1";
+    if (second && !line.starts_with("D:")) hid << line << "\n";
+  }
+  std::ofstream(folder / "trace.toml") << "format = 1\nfps = 60\n\n[[device]]\nname = \"dials\"\nkind = \"dial box\"\n"
+                                          "file = \"dials.hid\"\ndevice = \"Keydial mini-050\"\nvendor = \"256c\"\n"
+                                          "product = \"8251\"\n";
+  return true;
+}
+
+/// A six-second Motion-JPEG clip at one frame a second, each frame another colour.
+bool recordClip(const std::filesystem::path& file, std::string& why) {
+  media::RecorderOptions options;
+  options.path = file;
+  options.width = 32;
+  options.height = 32;
+  options.fps = 1;
+  auto recorder = media::Recorder::create(options);
+  if (!recorder) {
+    why = recorder.error().describe();
+    return false;
+  }
+  Image frame;
+  frame.width = 32;
+  frame.height = 32;
+  frame.channels = 4;
+  for (int i = 0; i < 6; ++i) {
+    frame.pixels.assign(32 * 32 * 4, 255);
+    for (std::size_t p = 0; p < frame.pixels.size(); p += 4) frame.pixels[p + static_cast<std::size_t>(i % 3)] = 40;
+    if (auto r = (*recorder)->push(frame); !r) {
+      why = r.error().describe();
+      return false;
+    }
+  }
+  if (auto r = (*recorder)->finish(); !r) {
+    why = r.error().describe();
+    return false;
+  }
+  return true;
+}
 
 TEST(Soak, ADayOfTheDefaultShowStaysFlat) {
   auto output = render::createHeadlessOutput({48, 48});
   if (!output) GTEST_SKIP() << "no headless EGL here: " << output.error().describe();
   auto renderer = render::Renderer::create();
   ASSERT_TRUE(renderer);
+  registerShowFactories();  // the replay dial box, the movie stream and the movie item
 
   const auto dir = test::scratchDir("soak");
+  std::string why;
+  if (!writeKeydialTrace(dir / "keydial.trace", why)) GTEST_SKIP() << why;
+  ASSERT_TRUE(recordClip(dir / "clip.avi", why)) << why;
   std::filesystem::copy_file(test::sourceDir() / "configs/shows/video-wall/screens.png", dir / "bars.png");
-  std::filesystem::copy_file(test::sourceDir() / "configs/shows/video-wall/clips/loop.webm", dir / "loop.webm");
   std::ofstream(dir / "show.toml") << R"(
 [show]
 name = "Soak"
@@ -100,22 +164,18 @@ entry = "default"
 
 [devices.dials]
 kind = "dial_box"
-backend = "synthetic"
+backend = "replay"
+trace = "keydial.trace"
 loop = true
-script = [
-  { at = "40s", dial = 0, turns = 0.1 }, { at = "41s", dial = 1, turns = -0.2 }, { at = "42s", dial = 3, turns = 0.05 },
-  { at = "50s", button = 0 }, { at = "51s", button = 0, pressed = false },
-  { at = "25m", dial = 2, turns = 0.3 },
-]
 
 [[bindings]]
 device = "dials"
-button = 0
-action = "next"
+dial = 0
+action = "rotate_y"
 
 [media.loop]
 kind = "movie"
-file = "loop.webm"
+file = "clip.avi"
 
 [textures."screens.png"]
 source = "loop"
@@ -130,6 +190,11 @@ duration = "5m"
 name = "dark"
 entry = "black"
 duration = "3m"
+
+[[kiosk.playlist]]
+name = "clip"
+entry = "clip.avi"
+duration = "4m"
 
 [[kiosk.playlist]]
 name = "cube again"
@@ -210,7 +275,15 @@ requests_per_second = 1000
     rss.push_back(residentBytes());
     fds.push_back(fds.empty() ? openFds() : settledFds(fds.front()));
   }
-  EXPECT_EQ(modes.seen(), (std::set<std::string>{"active", "attract", "closed"})) << "the day went through every mode";
+  EXPECT_EQ(modes.seen(), (std::set<std::string>{"active", "attract", "closed"}))
+      << "the day went through every mode (active: the replayed knob and key woke the attract loop)";
+  const StatusSnapshot status = board.snapshot(midnight);
+  ASSERT_EQ(status.devices.size(), 1u);
+  EXPECT_EQ(status.devices[0].state, "live") << status.devices[0].message;
+  ASSERT_EQ(status.streams.size(), 1u);
+  EXPECT_EQ(status.streams[0].state, "playing") << status.streams[0].message;
+  EXPECT_NE(status.streams[0].message.find("loops"), std::string::npos) << status.streams[0].message;
+  EXPECT_TRUE(modes.playedClip()) << "the movie item played";
   // Flat after the warm-up: the first opening at 08:00 draws the cube (shaders, meshes, the GL
   // driver's buffers) and the log's ring of recent records fills; from 09:00 on nothing grows.
   // 256 KiB over 14 hours is 6 bytes a frame: a per-frame leak of any size fails this.
