@@ -445,7 +445,7 @@ TEST(MovieItem, LetterboxKeepsTheAspectAndCentres) {
   const render::PictureRect wide = letterbox(1920, 1080, {1000, 1000});
   EXPECT_FLOAT_EQ(wide.width, 1000);
   EXPECT_FLOAT_EQ(wide.height, 562.5f);
-  EXPECT_FLOAT_EQ(wide.x, 0);
+  EXPECT_NEAR(wide.x, 0, 1e-3);
   EXPECT_FLOAT_EQ(wide.y, 218.75f);
   const render::PictureRect tall = letterbox(480, 640, {1280, 720});  // pillarbox
   EXPECT_FLOAT_EQ(tall.height, 720);
@@ -487,11 +487,15 @@ duration = "1h"
   EXPECT_EQ(litInRows(first, 0, top - 1), 0u) << "black bars above the picture";
   EXPECT_EQ(litInRows(first, 48 - top + 1, 48), 0u) << "and below";
   EXPECT_GT(litInRows(first, top + 1, 48 - top - 1), 0u) << "the movie's first frame is on screen at once";
-  // Played once through, at 30 frames a second of show time, then the cube.
+  // Played once through, at 30 frames a second of show time, then the cube. (run(n) draws n
+  // frames and moves the clock on by n - 1 of them: each run starts where the last one ended.)
   const auto frames = static_cast<int>(toSeconds(info->duration) * 30);
-  int played = 1;
+  h.run(frames - 5);
+  EXPECT_EQ(h.item(), "clip") << "still playing just before its end";
+  EXPECT_EQ(h.recorder().blackFrames(), 0u);
+  int played = frames - 6;
   while (h.item() == "clip" && played < frames + 60) {
-    h.run(1);
+    h.run(2);
     ++played;
   }
   EXPECT_EQ(h.item(), "cube") << "the movie ended by itself and the list moved on";
@@ -546,7 +550,8 @@ TEST(ShowDirector, AnItemsTexturesLeaveTheRegistryWhenItIsReplaced) {
   Harness h("item-textures");
   OPEN_OR_SKIP(h);
   std::filesystem::copy_file(test::sourceDir() / "configs/shows/camera-sculpture/camera.png", h.dir() / "pic.png");
-  std::ofstream(h.dir() / "tri.mtl") << "newmtl skin\nKd 1 1 1\nmap_Kd pic.png\n";
+  std::filesystem::copy_file(test::sourceDir() / "configs/shows/camera-sculpture/camera.png", h.dir() / "skin.png");
+  std::ofstream(h.dir() / "tri.mtl") << "newmtl skin\nKd 1 1 1\nmap_Kd skin.png\n";
   std::ofstream(h.dir() / "tri.obj") << "mtllib tri.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0.5 1\n"
                                         "vn 0 0 1\nusemtl skin\nf 1/1/1 2/2/1 3/3/1\n";
   ASSERT_TRUE(h.install(R"(
@@ -565,15 +570,15 @@ duration = "1s"
   ASSERT_EQ(h.item(), "cube");
   const std::size_t base = h.renderer().textures().size();
   EXPECT_NE(h.renderer().textures().find("plain"), nullptr);
-  h.run(30);
+  h.run(32);  // one second on: the next item
   ASSERT_EQ(h.item(), "triangle");
   EXPECT_EQ(h.renderer().textures().size(), base + 1) << "the model's map is uploaded while it plays";
   for (int round = 0; round < 3; ++round) {
-    h.run(30);
+    h.run(31);
     ASSERT_EQ(h.item(), "cube");
     EXPECT_EQ(h.renderer().textures().size(), base) << "its map leaves with it (round " << round << ")";
     EXPECT_NE(h.renderer().textures().find("plain"), nullptr) << "the manifest's texture stays";
-    h.run(30);
+    h.run(31);
     ASSERT_EQ(h.item(), "triangle");
     EXPECT_EQ(h.renderer().textures().size(), base + 1) << "and comes back when it plays again";
   }

@@ -1,7 +1,7 @@
 // A day of unattended running in seconds: the default show in a playlist with the attract
 // loop, opening hours and idle time-outs; a dial box replaying a real recording (the Huion
 // Keydial mini's knob and play/pause key from ../shared/testdata/hid, put in a trace folder by
-// the test and looped); a real movie (a Motion-JPEG clip the test records with media's recorder)
+// the test and looped); a real movie (a VP9 clip the test records with media's recorder)
 // looping on a texture all day and playing as a playlist item; crash-recovery saves; and the
 // status server asked for /health, /metrics, / and /snapshot.png every simulated hour. 24 hours
 // on a ManualClock at one frame per 2 s of show time (43,200 frames). Resident memory and open
@@ -114,7 +114,7 @@ bool writeKeydialTrace(const std::filesystem::path& folder, std::string& why) {
   return true;
 }
 
-/// A six-second Motion-JPEG clip at one frame a second, each frame another colour.
+/// A six-second VP9 clip at one frame a second, each frame another colour.
 bool recordClip(const std::filesystem::path& file, std::string& why) {
   media::RecorderOptions options;
   options.path = file;
@@ -155,7 +155,7 @@ TEST(Soak, ADayOfTheDefaultShowStaysFlat) {
   const auto dir = test::scratchDir("soak");
   std::string why;
   if (!writeKeydialTrace(dir / "keydial.trace", why)) GTEST_SKIP() << why;
-  ASSERT_TRUE(recordClip(dir / "clip.avi", why)) << why;
+  ASSERT_TRUE(recordClip(dir / "clip.webm", why)) << why;
   std::filesystem::copy_file(test::sourceDir() / "configs/shows/video-wall/screens.png", dir / "bars.png");
   std::ofstream(dir / "show.toml") << R"(
 [show]
@@ -175,7 +175,7 @@ action = "rotate_y"
 
 [media.loop]
 kind = "movie"
-file = "clip.avi"
+file = "clip.webm"
 
 [textures."screens.png"]
 source = "loop"
@@ -193,7 +193,7 @@ duration = "3m"
 
 [[kiosk.playlist]]
 name = "clip"
-entry = "clip.avi"
+entry = "clip.webm"
 duration = "4m"
 
 [[kiosk.playlist]]
