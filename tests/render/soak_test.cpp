@@ -13,7 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <httplib.h>
+#include <malloc.h>
 #include <unistd.h>
 
 #include <array>
@@ -48,6 +50,10 @@ std::size_t residentBytes() {
   return resident * static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
 }
 
+/// Bytes malloc has handed out and not had back, over every arena (and its mmapped blocks): what a
+/// leak grows. Resident memory also moves when a thread's malloc arena takes another heap.
+std::size_t heapInUse() { return ::mallinfo2().uordblks + ::mallinfo2().hblkhd; }
+
 std::size_t openFds() {
   std::size_t n = 0;
   for (const auto& e : std::filesystem::directory_iterator("/proc/self/fd")) {
@@ -65,6 +71,16 @@ std::size_t settledFds(std::size_t expected) {
     n = openFds();
   }
   return n;
+}
+
+/// What the open descriptors are, for a failure message.
+std::string describeFds() {
+  std::string out;
+  for (const auto& e : std::filesystem::directory_iterator("/proc/self/fd")) {
+    std::error_code ec;
+    out += e.path().filename().string() + "=" + std::filesystem::read_symlink(e.path(), ec).string() + " ";
+  }
+  return out;
 }
 
 /// Notes every kiosk mode the day went through.
@@ -202,7 +218,7 @@ entry = "default"
 duration = "7m"
 
 [kiosk.attract]
-idle_timeout = "90s"
+idle_timeout = "3m"
 items = [ { entry = "default", name = "attract" } ]
 
 [kiosk.schedule]
@@ -244,6 +260,9 @@ requests_per_second = 1000
   constexpr int kHours = 24;
   std::vector<std::size_t> rss;
   std::vector<std::size_t> fds;
+  std::vector<std::size_t> heap;
+  std::vector<std::size_t> mmapped;  // the part of heap in large mmapped blocks
+  std::vector<std::string> fdLists;  // what was open when the count was over the bound
   httplib::Client client("127.0.0.1", (*server)->port());
   for (int hour = 0; hour < kHours; ++hour) {
     FrameLoop frameLoop({0.5, 1800}, clock, &clock, **loop, show, **output, **renderer);
@@ -273,7 +292,11 @@ requests_per_second = 1000
     snapshot.join();
     (*state)->flush();
     rss.push_back(residentBytes());
+    heap.push_back(heapInUse());
+    mmapped.push_back(::mallinfo2().hblkhd);
     fds.push_back(fds.empty() ? openFds() : settledFds(fds.front()));
+    if (fds.back() > fds[std::min<std::size_t>(fds.size() - 1, 2)] + 8)
+      fdLists.push_back(fmt::format("hour {}: {}", hour, describeFds()));
   }
   EXPECT_EQ(modes.seen(), (std::set<std::string>{"active", "attract", "closed"}))
       << "the day went through every mode (active: the replayed knob and key woke the attract loop)";
@@ -286,13 +309,33 @@ requests_per_second = 1000
   EXPECT_TRUE(modes.playedClip()) << "the movie item played";
   // Flat after the warm-up: the first opening at 08:00 draws the cube (shaders, meshes, the GL
   // driver's buffers) and the log's ring of recent records fills; from 09:00 on nothing grows.
-  // 256 KiB over 14 hours is 6 bytes a frame: a per-frame leak of any size fails this.
+  // Mesa's llvmpipe takes a 1 MiB block for its caches once in a while, on its own schedule (a
+  // mmap catchpoint in gdb shows it under Renderer::drawSurface, late in the day): large mmapped
+  // blocks may grow by at most 1.1 MiB; the rest of the heap in use, where every small object
+  // lives, by at most 256 KiB over 14 hours (6 bytes a frame), so that a leak per frame, per movie
+  // loop or per request fails.
+  const auto small = [&](std::size_t h) {
+    return static_cast<std::ptrdiff_t>(heap[h]) - static_cast<std::ptrdiff_t>(mmapped[h]);
+  };
+  EXPECT_LE(small(heap.size() - 1) - small(9), std::ptrdiff_t{256} * 1024)
+      << "the heap in use (without large blocks) grew by " << (small(heap.size() - 1) - small(9)) / 1024
+      << " KiB from 09:00 to midnight";
+  EXPECT_LE(mmapped.back(), mmapped[9] + std::size_t{1126} * 1024)
+      << "large blocks grew by " << (mmapped.back() - mmapped[9]) / 1024 << " KiB";
   const std::size_t baseline = rss[9];
   const std::size_t highest = *std::max_element(rss.begin() + 9, rss.end());
-  EXPECT_LE(rss.back(), baseline + std::size_t{256} * 1024)
+  EXPECT_LE(rss.back(), baseline + std::size_t{2048} * 1024)
       << "resident memory grew by " << (rss.back() - baseline) / 1024 << " KiB from 09:00 to midnight";
-  EXPECT_LE(highest, baseline + std::size_t{1536} * 1024) << "a peak of " << (highest - baseline) / 1024 << " KiB";
-  for (int hour = 2; hour < kHours; ++hour) EXPECT_EQ(fds[static_cast<std::size_t>(hour)], fds[2]) << "hour " << hour;
+  EXPECT_LE(highest, baseline + std::size_t{3072} * 1024) << "a peak of " << (highest - baseline) / 1024 << " KiB";
+  // GStreamer's pipelines open and close socket pairs as the clips loop and the item restarts, so
+  // the count at a given moment varies by a few; a descriptor leaked per loop (every 6 s) or
+  // per request would add hundreds an hour.
+  for (int hour = 2; hour < kHours; ++hour) {
+    EXPECT_LE(fds[static_cast<std::size_t>(hour)], fds[2] + 8) << "hour " << hour;
+  }
+  if (!fdLists.empty()) {
+    for (const std::string& l : fdLists) std::printf("soak: %s\n", l.c_str());
+  }
   const FrameFigures figures = board.frameFigures();
   EXPECT_GT(figures.frames, 0);
   RecordProperty("rss_first_kib", static_cast<int>(rss.front() / 1024));
@@ -301,9 +344,18 @@ requests_per_second = 1000
   std::string series;
   for (const std::size_t r : rss) series += std::to_string(r / 1024) + " ";
   std::printf("soak: resident KiB by hour: %s\n", series.c_str());
+  series.clear();
+  for (const std::size_t h : heap) series += std::to_string(h / 1024) + " ";
+  std::printf("soak: heap in use KiB by hour: %s\n", series.c_str());
+  series.clear();
+  for (const std::size_t h : mmapped) series += std::to_string(h / 1024) + " ";
+  std::printf("soak: of which mmapped blocks, KiB: %s\n", series.c_str());
+  series.clear();
+  for (const std::size_t n : fds) series += std::to_string(n) + " ";
+  std::printf("soak: open descriptors by hour: %s\n", series.c_str());
   std::printf(
       "soak: 24 simulated hours, %lld frames; resident %zu KiB at 09:00, %zu KiB at midnight (highest %zu "
-      "KiB); %zu open descriptors throughout\n",
+      "KiB); %zu open descriptors at midnight\n",
       static_cast<long long>(figures.frames), baseline / 1024, rss.back() / 1024, highest / 1024, fds.back());
 }
 
