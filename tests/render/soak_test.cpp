@@ -4,7 +4,7 @@
 // the test and looped); a real movie (a VP9 clip the test records with media's recorder)
 // looping on a texture all day and playing as a playlist item; crash-recovery saves; and the
 // status server asked for /health, /metrics, / and /snapshot.png every simulated hour. 24 hours
-// on a ManualClock at one frame per 2 s of show time (43,200 frames). Resident memory and open
+// on a ManualClock at one frame per 4 s of show time (21,600 frames). Resident memory and open
 // file descriptors are sampled every hour and must stay flat once the day's first opening
 // (08:00) has drawn the cube and filled the caches.
 // Example failures: a string or vector that grows with every item change or every request; a
@@ -238,7 +238,7 @@ requests_per_second = 1000
   ManualClock clock(Nanos{0}, midnight);
   auto loop = runtime::EventLoop::create(clock);
   ASSERT_TRUE(loop);
-  StatusBoard board(midnight, 0.5);
+  StatusBoard board(midnight, 0.25);
   runtime::EventLoop* eventLoop = loop->get();
   board.setWake([eventLoop] { eventLoop->wake(); });
   BoundedQueue<Event> events(1024, [eventLoop] { eventLoop->wake(); });
@@ -251,12 +251,12 @@ requests_per_second = 1000
 
   runtime::Show show;
   ShowDirector director(
-      DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, state->get(), 0.5});
+      DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, state->get(), 0.25});
   director.install(std::move(*loaded), clock.now(), std::nullopt);
   FrameMetrics metrics(board, &events);
   ModeWatcher modes(director);
 
-  // An hour at a time: 1800 frames of 2 s.
+  // An hour at a time: 900 frames of 4 s.
   constexpr int kHours = 24;
   std::vector<std::size_t> rss;
   std::vector<std::size_t> fds;
@@ -265,7 +265,7 @@ requests_per_second = 1000
   std::vector<std::string> fdLists;  // what was open when the count was over the bound
   httplib::Client client("127.0.0.1", (*server)->port());
   for (int hour = 0; hour < kHours; ++hour) {
-    FrameLoop frameLoop({0.5, 1800}, clock, &clock, **loop, show, **output, **renderer);
+    FrameLoop frameLoop({0.25, 900}, clock, &clock, **loop, show, **output, **renderer);
     frameLoop.addParticipant(metrics);
     frameLoop.addParticipant(director);
     frameLoop.addParticipant(modes);
@@ -285,7 +285,7 @@ requests_per_second = 1000
     for (int i = 0; i < 2000 && board.snapshotRequests().size() == 0; ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
-    FrameLoop one({0.5, 1}, clock, &clock, **loop, show, **output, **renderer);
+    FrameLoop one({0.25, 1}, clock, &clock, **loop, show, **output, **renderer);
     one.addParticipant(metrics);
     one.addParticipant(director);
     ASSERT_TRUE(one.run());
@@ -312,7 +312,7 @@ requests_per_second = 1000
   // Mesa's llvmpipe takes a 1 MiB block for its caches once in a while, on its own schedule (a
   // mmap catchpoint in gdb shows it under Renderer::drawSurface, late in the day): large mmapped
   // blocks may grow by at most 1.1 MiB; the rest of the heap in use, where every small object
-  // lives, by at most 256 KiB over 14 hours (6 bytes a frame), so that a leak per frame, per movie
+  // lives, by at most 256 KiB over 14 hours (12 bytes a frame), so that a leak per frame, per movie
   // loop or per request fails.
   const auto small = [&](std::size_t h) {
     return static_cast<std::ptrdiff_t>(heap[h]) - static_cast<std::ptrdiff_t>(mmapped[h]);

@@ -35,7 +35,9 @@ struct ShowFolder {
     writeFile(dir / "wall.sce", "import wall.obj\n");
     writeFile(dir / "wall.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     writeFile(dir / "room.cave", "facet[2]\n");
-    writeFile(dir / "clips" / "loop.webm", "not really a movie");
+    fs::create_directories(dir / "clips");
+    fs::copy_file(test::sourceDir() / "configs/shows/video-wall/clips/loop.webm", dir / "clips" / "loop.webm");
+    writeFile(dir / "clips" / "broken.webm", "not really a movie");
     writeFile(dir / "site.trace" / "trace.toml", "format = 1\nfps = 60\n");
     fs::create_directories(dir / "empty.trace");
     fs::copy_file(test::sourceDir() / "configs/shows/camera-sculpture/camera.png", dir / "offline.png");
@@ -252,14 +254,13 @@ TEST(ManifestErrors, EntriesMustBeSomethingAShowPlays) {
 // Example failure: a text file renamed .webm passes the check and fails on the wall.
 TEST(ManifestErrors, MoviesAreReadByGStreamer) {
   ShowFolder f("movies");
-  fs::copy_file(test::sourceDir() / "configs/shows/video-wall/clips/loop.webm", f.dir / "real.webm");
-  const auto bad = f.read("[show]\nentry = \"clips/loop.webm\"\n");
+  const auto bad = f.read("[show]\nentry = \"clips/broken.webm\"\n");
   EXPECT_FALSE(bad.manifest) << bad.text;
-  EXPECT_TRUE(hasError(bad, 2, "show.entry: clips/loop.webm: ")) << bad.text;
-  EXPECT_NE(bad.text.find("show.toml:2: show.entry: clips/loop.webm: "), std::string::npos) << bad.text;
-  const auto media = f.read("[media.m]\nkind = \"movie\"\nfile = \"clips/loop.webm\"\n");
-  EXPECT_TRUE(hasError(media, 3, "media.m.file: clips/loop.webm: ")) << media.text;
-  const auto ok = f.read("[show]\nentry = \"real.webm\"\n");
+  EXPECT_TRUE(hasError(bad, 2, "show.entry: clips/broken.webm: cannot be read as a movie")) << bad.text;
+  EXPECT_NE(bad.text.find("show.toml:2: show.entry: clips/broken.webm: "), std::string::npos) << bad.text;
+  const auto media = f.read("[media.m]\nkind = \"movie\"\nfile = \"clips/broken.webm\"\n");
+  EXPECT_TRUE(hasError(media, 3, "media.m.file: clips/broken.webm: ")) << media.text;
+  const auto ok = f.read("[show]\nentry = \"clips/loop.webm\"\n");
   ASSERT_TRUE(ok.manifest) << ok.text;
   EXPECT_EQ(ok.text.find("contents are not checked"), std::string::npos) << ok.text;
   EXPECT_EQ(ok.diagnostics.errorCount(), 0u) << ok.text;
