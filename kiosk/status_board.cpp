@@ -132,7 +132,7 @@ void percentiles(std::vector<float>& values, double& p50, double& p90, double& p
   if (values.empty()) return;
   std::sort(values.begin(), values.end());
   const auto at = [&](double q) {
-    const auto i = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5);
+    const auto i = static_cast<std::size_t>(std::lround(q * static_cast<double>(values.size() - 1)));
     return static_cast<double>(values[std::min(i, values.size() - 1)]);
   };
   p50 = at(0.50);

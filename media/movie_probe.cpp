@@ -5,6 +5,8 @@
 
 #include <gst/pbutils/pbutils.h>
 
+#include <cmath>
+
 #include <fmt/format.h>
 #include <fmt/std.h>
 
@@ -109,7 +111,7 @@ Result<MovieInfo> probeMovie(const std::filesystem::path& file, std::chrono::mil
   const GstClockTime duration = gst_discoverer_info_get_duration(info.get());
   if (fromGstTime(duration) > Nanos{0}) {
     out.duration = fromGstTime(duration);
-    if (out.fps > 0) out.frameCount = static_cast<std::int64_t>(toSeconds(out.duration) * out.fps + 0.5);
+    if (out.fps > 0) out.frameCount = std::llround(toSeconds(out.duration) * out.fps);
   }
   out.codec = codecOf(static_cast<GstDiscovererStreamInfo*>(videos->data));
   std::unique_ptr<GList, StreamListFree> audios(gst_discoverer_info_get_audio_streams(info.get()));
