@@ -16,11 +16,16 @@
 #include "kiosk/options.h"
 #include "kiosk/readers.h"
 #include "media/image_io.h"
+#include "media/movie_probe.h"
 #include "runtime/script/interpreter.h"
+#include "sim/providers.h"
 
 namespace basalt::kiosk {
 
 namespace {
+
+/// How long `basalt check` (and a reload's checks) give one movie file.
+constexpr std::chrono::seconds kMovieProbeTimeout{5};
 
 /// A show manifest: every section and every file it names (kiosk/check_manifest.cpp prints
 /// the problems and a summary line).
@@ -72,6 +77,58 @@ std::vector<Diagnostic> checkScriptContent(const std::filesystem::path& file) {
   return out;
 }
 
+/// A movie a manifest names (a media file or an item): GStreamer must be able to read it.
+std::vector<Diagnostic> checkMovieContent(const std::filesystem::path& file) {
+  std::vector<Diagnostic> out;
+  auto info = media::probeMovie(file, kMovieProbeTimeout);
+  if (!info) {
+    out.push_back({Severity::kError, file, 0, info.error().message()});
+  } else if (info->duration <= Nanos{0}) {
+    out.push_back({Severity::kWarning, file, 0,
+                   "its length is unknown (a stream without an index): it plays, but cannot be resumed or seeked"});
+  }
+  return out;
+}
+
+/// A replay trace a manifest names: its trace.toml and every recording in it must read, and
+/// each recorded dial box must decode (what the replay backend opens).
+std::vector<Diagnostic> checkTraceContent(const std::filesystem::path& folder) {
+  std::vector<Diagnostic> out;
+  const auto report = [&](const Error& e, const std::filesystem::path& fallback) {
+    // The trace reader's errors carry "file:line"; keep it as the diagnostic's place.
+    std::filesystem::path file = fallback;
+    int line = 0;
+    const std::string& where = e.where();
+    if (const auto colon = where.rfind(':'); colon != std::string::npos && colon + 1 < where.size() &&
+                                             std::all_of(where.begin() + static_cast<std::ptrdiff_t>(colon) + 1,
+                                                         where.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+      file = where.substr(0, colon);
+      line = std::stoi(where.substr(colon + 1));
+    } else if (!where.empty()) {
+      file = where;
+    }
+    out.push_back({Severity::kError, file, line, e.message()});
+  };
+  sim::ReplayProvider replay;
+  if (auto r = replay.addTrace(folder); !r) {
+    report(r.error(), folder / "trace.toml");
+    return out;
+  }
+  std::size_t devices = 0;
+  for (const devices::DeviceCandidate& c : replay.enumerate()) {
+    ++devices;
+    if (!c.problem.empty()) {
+      out.push_back({Severity::kError, c.info.path.empty() ? folder : std::filesystem::path(c.info.path), 0,
+                     fmt::format("recorded {} cannot be replayed: {}", c.info.name, c.problem)});
+    }
+  }
+  if (devices == 0) {
+    out.push_back(
+        {Severity::kWarning, folder / "trace.toml", 0, "the trace records no device: its replay device stays absent"});
+  }
+  return out;
+}
+
 std::string lowerExtension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -98,7 +155,11 @@ const std::map<std::string, ContentChecker, std::less<>>& contentCheckers() {
       {".ppm", checkImageContent},  {".pgm", checkImageContent},  {".pnm", checkImageContent},
       {".tga", checkImageContent},  {".bmp", checkImageContent},  {".hdr", checkImageContent},
       {".mdl", checkScriptContent}, {".sce", checkSceneContent},  {".obj", checkModelContent},
-      {".off", checkModelContent},  {".cave", checkCaveContent},
+      {".off", checkModelContent},  {".cave", checkCaveContent},  {".trace", checkTraceContent},
+      {".mkv", checkMovieContent},  {".mp4", checkMovieContent},  {".mov", checkMovieContent},
+      {".webm", checkMovieContent}, {".avi", checkMovieContent},  {".mpg", checkMovieContent},
+      {".mpeg", checkMovieContent}, {".m1v", checkMovieContent},  {".m2v", checkMovieContent},
+      {".ogv", checkMovieContent},  {".ts", checkMovieContent},   {".m4v", checkMovieContent},
   };
   return checkers;
 }

@@ -610,12 +610,24 @@ class Reader {
   }
 
   /// Runs the checker for the file's extension, once per file.
-  void checkContents(const std::filesystem::path& path, int line, std::string_view what) {
+  /// `kind` is the checker's key when the name does not tell it (a trace folder: ".trace").
+  void checkContents(const std::filesystem::path& path, int line, std::string_view what, std::string kind = {}) {
     if (!checked_.insert(path.string()).second) return;
-    const std::string ext = extensionOf(path);
+    const std::string ext = kind.empty() ? extensionOf(path) : std::move(kind);
     if (options_.fileCheckers) {
       if (auto it = options_.fileCheckers->find(ext); it != options_.fileCheckers->end()) {
-        for (Diagnostic& d : it->second(path)) diagsReferenced_.push_back(std::move(d));
+        for (Diagnostic& d : it->second(path)) {
+          if (d.line == 0 && d.file == path) {
+            // A problem with the file as a whole (a movie that cannot play, an image that does
+            // not decode): reported at the manifest line that names it.
+            std::error_code ec;
+            const std::filesystem::path canonicalFolder = std::filesystem::weakly_canonical(folder_, ec);
+            std::string name = path.lexically_relative(ec ? folder_ : canonicalFolder).generic_string();
+            if (name.empty() || name.starts_with("..")) name = path.filename().string();
+            d = {d.severity, shown_, line, fmt::format("{}: {}: {}", what, name, d.message)};
+          }
+          diagsReferenced_.push_back(std::move(d));
+        }
         return;
       }
     }
@@ -898,6 +910,7 @@ class Reader {
                                                 path, s->get()));
             } else {
               d.trace = *p;
+              checkContents(*p, lineOf(*trace), path + ".trace", ".trace");
             }
           }
         } else {

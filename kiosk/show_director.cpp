@@ -55,6 +55,7 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   while (context_.events.pop(stale)) {
   }
   player_ = nullptr;
+  itemKey_.clear();  // the new show's players are new: what the old item uploaded goes
   std::unique_ptr<LoadedShow> old = std::move(show_);
   show_ = std::move(show);
   reportedFailures_.clear();
@@ -363,9 +364,11 @@ void ShowDirector::applyProgramme(Nanos now) {
       displayOn_ = true;
     }
     if (!p.item || p.display != DisplayState::kOn) {
+      releaseItemTextures({});
       context_.show = runtime::Show();
     } else {
       const std::string key = entryKey(p.item->entry);
+      releaseItemTextures(key);
       const auto found = show_->players.find(key);
       Result<void> started = fail(Errc::kInternal, "no player");
       if (found == show_->players.end()) {
@@ -374,6 +377,9 @@ void ShowDirector::applyProgramme(Nanos now) {
                                                                  : Error(Errc::kInternal, "item was not prepared"));
       } else {
         found->second->useTextures(context_.renderer.textures());
+        // An item with a duration loops until it is up; so does the only item of its list. One
+        // without, in a list of several, plays once and the list moves on at its end.
+        found->second->setPlayback({p.item->duration > Nanos{0} || p.count <= 1, context_.clock.isManual()});
         started = found->second->start(context_.show, now - p.itemStart, context_.fps);
       }
       if (!started) {
@@ -438,7 +444,33 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
   return {};
 }
 
-Result<void> ShowDirector::afterDraw(const FrameContext& /*frame*/, render::Output& output) {
+void ShowDirector::releaseItemTextures(const std::string& nextKey) {
+  if (!itemKey_.empty() && itemKey_ == nextKey) return;  // the same item again keeps its images
+  render::TextureRegistry& textures = context_.renderer.textures();
+  std::vector<std::string> now = textures.names();
+  if (!itemKey_.empty() || !nextKey.empty()) {
+    for (const std::string& name : now) {
+      if (std::binary_search(texturesBeforeItem_.begin(), texturesBeforeItem_.end(), name)) continue;
+      if (std::any_of(show_->textures.begin(), show_->textures.end(),
+                      [&](const LoadedTexture& t) { return t.name == name; })) {
+        continue;  // the manifest's: the director's own
+      }
+      textures.remove(name);
+    }
+  }
+  itemKey_ = nextKey;
+  texturesBeforeItem_ = textures.names();  // sorted
+}
+
+Result<void> ShowDirector::afterDraw(const FrameContext& frame, render::Output& output) {
+  if (player_) {
+    // Items that draw over the scene (a movie's picture) do it before anything reads the frame.
+    if (auto r = player_->afterDraw(frame, output); !r) {
+      log::error(kLogDirector, "'{}' stopped: {}; moving on", policy_->current().item->name, r.error().describe());
+      policy_->itemFailed(frame.time);
+      applyProgramme(frame.time);
+    }
+  }
   std::shared_ptr<SnapshotRequest> request;
   if (!context_.board.snapshotRequests().pop(request)) return {};
   Image image;
@@ -454,6 +486,12 @@ Result<void> ShowDirector::afterDraw(const FrameContext& /*frame*/, render::Outp
 }
 
 void ShowDirector::afterPresent(const FrameContext& /*frame*/) {
+  // LAVA's performance meter, published when it has taken a new sample (every 2 s).
+  const runtime::PerformanceMeter& meter = context_.show.performance();
+  if (meter.updates != performanceUpdates_ && meter.updates > 0) {
+    performanceUpdates_ = meter.updates;
+    context_.board.publishPerformance(meter);
+  }
   if (texturesPending_) {
     texturesPending_ = false;
     loadTexturesInBackground();

@@ -88,6 +88,8 @@ class ShowDirector final : public FrameParticipant {
   void publishShow();
   void publishDevices();
   void publishStreams();
+  /// Removes the textures the last item put in the registry, unless `nextKey` is that same item.
+  void releaseItemTextures(const std::string& nextKey);
 
   DirectorContext context_;
   std::unique_ptr<LoadedShow> show_;
@@ -118,6 +120,11 @@ class ShowDirector final : public FrameParticipant {
   std::int64_t reloadsApplied_ = 0;
   std::int64_t reloadsFailed_ = 0;
   std::int64_t lastReloadFrame_ = -1;
+  // Textures that belong to the playing item: what the registry holds beyond these names (and
+  // the manifest's textures) was put there by it. Frame loop only.
+  std::string itemKey_;
+  std::vector<std::string> texturesBeforeItem_;
+  std::uint64_t performanceUpdates_ = 0;  // the meter's sample last published
 };
 
 }  // namespace basalt::kiosk

@@ -18,6 +18,7 @@
 
 #include "kiosk/frame_loop.h"
 #include "kiosk/manifest.h"
+#include "render/output.h"
 #include "render/texture_registry.h"
 #include "runtime/error.h"
 #include "runtime/show/show.h"
@@ -44,8 +45,21 @@ class ItemPlayer {
     (void)show;
     return {};
   }
+  /// \brief After the show is drawn, before the frame is read back or presented: items that
+  /// draw over the scene (a movie's full-screen picture). An error ends the item.
+  [[nodiscard]] virtual Result<void> afterDraw(const FrameContext& frame, render::Output& output) {
+    (void)frame;
+    (void)output;
+    return {};
+  }
   /// \brief True once the item has ended by itself (a script's quit or end, a movie's end).
   [[nodiscard]] virtual bool ended() const { return false; }
+  /// \brief How the item is to play this time; the director calls it before each start().
+  struct Playback {
+    bool loop = false;         ///< play on from the start at the end (gapless) instead of ending
+    bool manualClock = false;  ///< the show runs on a ManualClock: wait for decoders, frames are exact
+  };
+  virtual void setPlayback(const Playback& playback) { (void)playback; }
 };
 
 /// \brief Makes the player of an entry. Called off the frame loop's thread.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 
 namespace basalt::kiosk {
 
@@ -77,8 +78,14 @@ void StatusBoard::recordFrame(std::int64_t frame, double workSeconds, double int
   if (atReload) longestAtReload_ = std::max(longestAtReload_, intervalSeconds);
   if (late) {
     ++late_;
+    droppedFrames_ += std::max<std::int64_t>(std::llround(intervalSeconds * nominalFps_) - 1, 1);
     if (atReload) ++missedAtReload_;
   }
+}
+
+void StatusBoard::publishPerformance(const runtime::PerformanceMeter& meter) {
+  std::lock_guard lock(mutex_);
+  performance_ = meter;
 }
 
 void StatusBoard::setNominalFps(double fps) {
@@ -125,7 +132,7 @@ void percentiles(std::vector<float>& values, double& p50, double& p90, double& p
   if (values.empty()) return;
   std::sort(values.begin(), values.end());
   const auto at = [&](double q) {
-    const auto i = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5);
+    const auto i = static_cast<std::size_t>(std::lround(q * static_cast<double>(values.size() - 1)));
     return static_cast<double>(values[std::min(i, values.size() - 1)]);
   };
   p50 = at(0.50);
@@ -148,6 +155,7 @@ FrameFigures StatusBoard::frameFigures() const {
     f.missedAtReload = missedAtReload_;
     f.longestAtReload = longestAtReload_;
     f.inputDropped = inputDropped_;
+    f.droppedFrames = droppedFrames_;
     f.window = filled_;
     intervals.assign(intervals_.begin(), intervals_.begin() + static_cast<std::ptrdiff_t>(filled_));
     work.assign(work_.begin(), work_.begin() + static_cast<std::ptrdiff_t>(filled_));
@@ -180,6 +188,7 @@ StatusSnapshot StatusBoard::snapshot(WallTime now) const {
     s.reloads = reloads_;
     s.reloadFailures = reloadFailures_;
     s.lastReload = lastReload_;
+    s.performance = performance_;
   }
   if (s.show.schedule)
     s.show.nextScheduleChange = s.show.schedule->nextChange(showClock_ ? showClock_->wallNow() : now);

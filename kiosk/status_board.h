@@ -20,6 +20,7 @@
 #include "runtime/clock.h"
 #include "runtime/image.h"
 #include "runtime/log.h"
+#include "runtime/show/show.h"
 
 namespace basalt::kiosk {
 
@@ -66,7 +67,10 @@ struct FrameFigures {
   std::int64_t lateFrames = 0;      ///< a present more than 1.5 frame periods after the previous
   std::int64_t missedAtReload = 0;  ///< late frames in the three frames after a reload swap
   std::uint64_t inputDropped = 0;   ///< input events lost to a full queue
-  double framesPerSecond = 0;       ///< over the recent window
+  /// Display refreshes that got no new frame: a present that came k frame periods after the
+  /// previous one dropped k - 1 frames (the screen showed the old picture meanwhile).
+  std::int64_t droppedFrames = 0;
+  double framesPerSecond = 0;                                                 ///< over the recent window
   double intervalP50 = 0, intervalP90 = 0, intervalP99 = 0, intervalMax = 0;  ///< seconds, present to present
   double workP50 = 0, workP90 = 0, workP99 = 0, workMax = 0;  ///< seconds of the loop's own work per frame
   double workMean = 0;                                        ///< seconds, over the window
@@ -89,6 +93,7 @@ struct StatusSnapshot {
   std::vector<log::Record> logTail;     ///< recent records, oldest first
   std::vector<log::Record> lastErrors;  ///< recent warnings and errors
   std::uint64_t errorsLogged = 0;
+  runtime::PerformanceMeter performance;  ///< LAVA's meter, as last sampled (updates == 0: not yet)
 };
 
 /// \brief A request from the control server to the frame loop, answered through `reply`.
@@ -149,6 +154,8 @@ class StatusBoard {
   void publishShow(ShowStatus status);
   void publishDevices(std::vector<DeviceStatus> devices);
   void publishStreams(std::vector<StreamStatus> streams);
+  /// \brief LAVA's performance meter (Show::performance()), after it took a new sample.
+  void publishPerformance(const runtime::PerformanceMeter& meter);
 
   // ---- any thread ----
   [[nodiscard]] StatusSnapshot snapshot(WallTime now) const;
@@ -179,6 +186,8 @@ class StatusBoard {
   std::int64_t missedAtReload_ = 0;         // guarded by mutex_
   double longestAtReload_ = 0;              // guarded by mutex_
   std::uint64_t inputDropped_ = 0;          // guarded by mutex_
+  std::int64_t droppedFrames_ = 0;          // guarded by mutex_
+  runtime::PerformanceMeter performance_;   // guarded by mutex_
   ShowStatus show_;                         // guarded by mutex_
   std::vector<DeviceStatus> devices_;       // guarded by mutex_
   std::vector<StreamStatus> streams_;       // guarded by mutex_

@@ -105,9 +105,16 @@ std::string healthJson(const StatusSnapshot& s) {
   out += fmt::format("    \"work_ms\": {{\"p50\": {:.3f}, \"p90\": {:.3f}, \"p99\": {:.3f}, \"max\": {:.3f}}},\n",
                      f.workP50 * 1e3, f.workP90 * 1e3, f.workP99 * 1e3, f.workMax * 1e3);
   out += fmt::format("    \"window\": {},\n    \"late\": {},\n    \"dropped\": {},\n", f.window, f.lateFrames,
-                     f.lateFrames);
+                     f.droppedFrames);
   out += fmt::format("    \"missed_at_reload\": {},\n    \"input_events_dropped\": {}\n  }},\n", f.missedAtReload,
                      f.inputDropped);
+  // LAVA's performance meter (manual §9): the last sampled frame's counts, rates over the sample.
+  const runtime::PerformanceMeter& m = s.performance;
+  out += fmt::format(
+      "  \"performance\": {{\"triangles\": {}, \"lines\": {}, \"points\": {}, \"parts\": {}, \"facets\": {}, "
+      "\"fps\": {:.2f}, \"primitives_per_second\": {:.0f}, \"sample_seconds\": {:.1f}, \"samples\": {}}},\n",
+      m.triangles, m.lines, m.points, m.parts, m.facets, m.framesPerSecond, m.primitivesPerSecond,
+      m.samplePeriodSeconds, m.updates);
   out += "  \"devices\": [";
   for (std::size_t i = 0; i < s.devices.size(); ++i) {
     const DeviceStatus& d = s.devices[i];
@@ -189,6 +196,25 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
   out += fmt::format("basalt_frame_interval_at_reload_max_seconds {:.6f}\n", f.longestAtReload);
   metric("basalt_input_events_dropped_total", "counter", "Input events lost to a full queue.");
   out += fmt::format("basalt_input_events_dropped_total {}\n", f.inputDropped);
+  metric("basalt_frames_dropped_total", "counter",
+         "Display refreshes that showed no new frame (a present k periods after the previous drops k - 1).");
+  out += fmt::format("basalt_frames_dropped_total {}\n", f.droppedFrames);
+  const runtime::PerformanceMeter& m = s.performance;
+  metric("basalt_performance_primitives", "gauge",
+         "LAVA's performance meter: primitives drawn in the last sampled frame, by kind.");
+  for (const auto& [kind, n] : {std::pair{"triangles", m.triangles}, {"lines", m.lines}, {"points", m.points}}) {
+    out += fmt::format("basalt_performance_primitives{{kind=\"{}\"}} {}\n", kind, n);
+  }
+  metric("basalt_performance_parts", "gauge", "LAVA's performance meter: parts drawn in the last sampled frame.");
+  out += fmt::format("basalt_performance_parts {}\n", m.parts);
+  metric("basalt_performance_facets", "gauge", "LAVA's performance meter: facets (views) drawn in the last frame.");
+  out += fmt::format("basalt_performance_facets {}\n", m.facets);
+  metric("basalt_performance_frames_per_second", "gauge",
+         "LAVA's performance meter: frames per second over its sample.");
+  out += fmt::format("basalt_performance_frames_per_second {:.3f}\n", m.framesPerSecond);
+  metric("basalt_performance_primitives_per_second", "gauge",
+         "LAVA's performance meter: primitives per second over its sample.");
+  out += fmt::format("basalt_performance_primitives_per_second {:.0f}\n", m.primitivesPerSecond);
   metric("basalt_kiosk_open", "gauge", "1 within opening hours.");
   out += fmt::format("basalt_kiosk_open {}\n", s.show.open ? 1 : 0);
   metric("basalt_kiosk_mode", "gauge", "1 for the kiosk's current mode.");

@@ -1,5 +1,6 @@
 #include "kiosk/stream_factories.h"
 
+#include "kiosk/movie_item.h"
 #include "kiosk/script_player.h"
 #include "kiosk/trace_video_glue.h"
 
@@ -465,6 +466,7 @@ void registerShowFactories() {
     setDialBoxFactory(DeviceBackend::kSerial, makeDialBoxFromSpec);
     setStreamFactory(MediaKind::kMovie, makeMovieStream);
     setStreamFactory(MediaKind::kCamera, makeCameraStream);
+    setItemFactory(EntryKind::kMovie, makeMovieItem);
   });
 }
 

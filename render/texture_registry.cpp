@@ -55,6 +55,13 @@ void TextureRegistry::remove(std::string_view name) {
   if (it != entries_.end()) entries_.erase(it);
 }
 
+std::vector<std::string> TextureRegistry::names() const {
+  std::vector<std::string> out;
+  out.reserve(entries_.size());
+  for (const auto& [name, entry] : entries_) out.push_back(name);
+  return out;
+}
+
 const TextureView* TextureRegistry::find(std::string_view name) const {
   auto it = entries_.find(name);
   return it == entries_.end() ? nullptr : &it->second.view;

@@ -7,6 +7,7 @@
 #include <map>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "render/gl.h"
 #include "render/output.h"
@@ -47,6 +48,8 @@ class TextureRegistry {
   void remove(std::string_view name);
   [[nodiscard]] const TextureView* find(std::string_view name) const;
   [[nodiscard]] std::size_t size() const { return entries_.size(); }
+  /// \brief The names of every texture, sorted (allocates: for item changes, not every frame).
+  [[nodiscard]] std::vector<std::string> names() const;
 
  private:
   struct Entry {

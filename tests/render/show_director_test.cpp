@@ -5,10 +5,13 @@
 // show, a movie) are skipped, and when none can, the screen is black rather than stuck; scripts,
 // scenes and models play as items (a script that ends or quits moves the playlist on); control
 // commands run on the show; a shuttle ring held off-centre turns the show frame after frame
-// until it is let go; outside opening hours the display goes off
-// (black where the output has no display to switch); a stream texture shows its fallback.
+// until it is let go; outside opening hours the display goes off (black where the output has no
+// display to switch); a stream texture shows its fallback; a movie plays as an item, full screen
+// and letterboxed, once (the list moves on at its end) or looping without a gap; the textures an
+// item uploads leave the registry when it is replaced.
 // Example failures: a black frame while the new show loads; a reload error that stops the show;
-// a button that does nothing; an unplayable item retried every frame.
+// a button that does nothing; an unplayable item retried every frame; a movie item stretched to
+// the screen or stuck on its last frame; a model's textures piling up in GPU memory item after item.
 
 #include <gtest/gtest.h>
 
@@ -17,11 +20,13 @@
 
 #include "kiosk/frame_loop.h"
 #include "kiosk/manifest.h"
+#include "kiosk/movie_item.h"
 #include "kiosk/readers.h"
 #include "kiosk/show_director.h"
 #include "kiosk/show_loader.h"
 #include "kiosk/status_board.h"
 #include "kiosk/time_zone.h"
+#include "media/movie_probe.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/event_loop.h"
@@ -45,6 +50,8 @@ class FrameRecorder final : public FrameParticipant {
     return {};
   }
   [[nodiscard]] const std::vector<std::size_t>& lit() const { return lit_; }
+  /// The last frame read back (RGBA, top row first).
+  [[nodiscard]] const Image& last() const { return image_; }
   [[nodiscard]] std::size_t blackFrames() const {
     return static_cast<std::size_t>(std::count(lit_.begin(), lit_.end(), std::size_t{0}));
   }
@@ -469,6 +476,161 @@ file = "bars.png"
   ASSERT_EQ(s.streams.size(), 1u);
   EXPECT_EQ(s.streams[0].state, "absent");
   EXPECT_NE(s.streams[0].message.find("showing the fallback image"), std::string::npos) << s.streams[0].message;
+}
+
+/// Lit pixels in the rows [from, to) of an RGBA image.
+std::size_t litInRows(const Image& image, std::uint32_t from, std::uint32_t to) {
+  std::size_t lit = 0;
+  for (std::uint32_t y = from; y < to; ++y) {
+    for (std::uint32_t x = 0; x < image.width; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * image.width + x) * 4;
+      if (image.pixels[i] + image.pixels[i + 1] + image.pixels[i + 2] > 30) ++lit;
+    }
+  }
+  return lit;
+}
+
+TEST(MovieItem, LetterboxKeepsTheAspectAndCentres) {
+  const render::PictureRect wide = letterbox(1920, 1080, {1000, 1000});
+  EXPECT_FLOAT_EQ(wide.width, 1000);
+  EXPECT_FLOAT_EQ(wide.height, 562.5f);
+  EXPECT_NEAR(wide.x, 0, 1e-3);
+  EXPECT_FLOAT_EQ(wide.y, 218.75f);
+  const render::PictureRect tall = letterbox(480, 640, {1280, 720});  // pillarbox
+  EXPECT_FLOAT_EQ(tall.height, 720);
+  EXPECT_FLOAT_EQ(tall.width, 540);
+  EXPECT_FLOAT_EQ(tall.x, 370);
+  EXPECT_FLOAT_EQ(letterbox(0, 10, {10, 10}).width, 0) << "an empty picture draws nothing";
+}
+
+/// The clip the video-wall example loops: its size, rate and length as GStreamer reads them.
+struct Clip {
+  std::filesystem::path file = test::sourceDir() / "configs/shows/video-wall/clips/loop.webm";
+};
+
+TEST(ShowDirector, AMovieItemPlaysLetterboxedAndTheListMovesOnAtItsEnd) {
+  setItemFactory(EntryKind::kMovie, makeMovieItem);
+  Clip clip;
+  auto info = media::probeMovie(clip.file);
+  ASSERT_TRUE(info) << info.error().describe();
+  ASSERT_GT(info->width, info->height) << "the test expects a landscape clip";
+  ASSERT_GT(info->duration, Nanos{0});
+  Harness h("movie-item");
+  OPEN_OR_SKIP(h);
+  std::filesystem::copy_file(clip.file, h.dir() / "clip.webm");
+  ASSERT_TRUE(h.install(R"(
+[[kiosk.playlist]]
+name = "clip"
+entry = "clip.webm"
+[[kiosk.playlist]]
+name = "cube"
+entry = "default"
+duration = "1h"
+)"));
+  ASSERT_EQ(h.item(), "clip");
+  h.run(1);
+  const Image& first = h.recorder().last();
+  const render::PictureRect rect = letterbox(info->width * info->pixelAspect, info->height, {48, 48});
+  const auto top = static_cast<std::uint32_t>(rect.y);
+  ASSERT_GT(top, 1u);
+  EXPECT_EQ(litInRows(first, 0, top - 1), 0u) << "black bars above the picture";
+  EXPECT_EQ(litInRows(first, 48 - top + 1, 48), 0u) << "and below";
+  EXPECT_GT(litInRows(first, top + 1, 48 - top - 1), 0u) << "the movie's first frame is on screen at once";
+  // Played once through, at 30 frames a second of show time, then the cube. (run(n) draws n
+  // frames and moves the clock on by n - 1 of them: each run starts where the last one ended.)
+  const auto frames = static_cast<int>(toSeconds(info->duration) * 30);
+  h.run(frames - 5);
+  EXPECT_EQ(h.item(), "clip") << "still playing just before its end";
+  EXPECT_EQ(h.recorder().blackFrames(), 0u);
+  int played = frames - 6;
+  while (h.item() == "clip" && played < frames + 60) {
+    h.run(2);
+    ++played;
+  }
+  EXPECT_EQ(h.item(), "cube") << "the movie ended by itself and the list moved on";
+  EXPECT_NEAR(played, frames, 3) << "it played for its length, not less, not longer";
+  h.run(1);
+  EXPECT_GT(litInRows(h.recorder().last(), 0, 8), 0u) << "the cube fills the screen, no bars";
+}
+
+TEST(ShowDirector, AMovieAloneInItsListLoopsWithoutAGap) {
+  setItemFactory(EntryKind::kMovie, makeMovieItem);
+  Clip clip;
+  auto info = media::probeMovie(clip.file);
+  ASSERT_TRUE(info) << info.error().describe();
+  Harness h("movie-loop");
+  OPEN_OR_SKIP(h);
+  std::filesystem::copy_file(clip.file, h.dir() / "clip.webm");
+  ASSERT_TRUE(h.install("[show]\nentry = \"clip.webm\"\n"));
+  const auto frames = static_cast<std::int64_t>(toSeconds(info->duration) * 30);
+  h.run(frames * 2 + 10);
+  EXPECT_EQ(h.item(), "clip.webm");
+  EXPECT_EQ(h.recorder().blackFrames(), 0u) << "no empty frame at the loop point";
+  const StatusSnapshot s = h.board().snapshot(WallTime{});
+  for (const auto& r : s.lastErrors) ADD_FAILURE() << "unexpected: " << r.message;
+}
+
+TEST(ShowDirector, AMovieItemThatCannotPlayIsReportedWithItsLine) {
+  setItemFactory(EntryKind::kMovie, makeMovieItem);
+  Harness h("movie-broken");
+  OPEN_OR_SKIP(h);
+  std::ofstream(h.dir() / "clip.webm") << "not a movie";
+  ASSERT_TRUE(h.install(R"(
+[[kiosk.playlist]]
+name = "clip"
+entry = "clip.webm"
+[[kiosk.playlist]]
+name = "cube"
+entry = "default"
+duration = "10s"
+)"));
+  EXPECT_EQ(h.item(), "cube");
+  h.run(2);
+  EXPECT_EQ(h.recorder().blackFrames(), 0u);
+  bool said = false;
+  for (const auto& r : h.board().snapshot(WallTime{}).lastErrors) {
+    said = said || (r.message.find("'clip' cannot play") != std::string::npos &&
+                    r.message.find("show.toml:4") != std::string::npos);
+  }
+  EXPECT_TRUE(said) << "the operator is told which line names the movie";
+}
+
+TEST(ShowDirector, AnItemsTexturesLeaveTheRegistryWhenItIsReplaced) {
+  Harness h("item-textures");
+  OPEN_OR_SKIP(h);
+  std::filesystem::copy_file(test::sourceDir() / "configs/shows/camera-sculpture/camera.png", h.dir() / "pic.png");
+  std::filesystem::copy_file(test::sourceDir() / "configs/shows/camera-sculpture/camera.png", h.dir() / "skin.png");
+  std::ofstream(h.dir() / "tri.mtl") << "newmtl skin\nKd 1 1 1\nmap_Kd skin.png\n";
+  std::ofstream(h.dir() / "tri.obj") << "mtllib tri.mtl\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0.5 1\n"
+                                        "vn 0 0 1\nusemtl skin\nf 1/1/1 2/2/1 3/3/1\n";
+  ASSERT_TRUE(h.install(R"(
+[textures.plain]
+file = "pic.png"
+[[kiosk.playlist]]
+name = "cube"
+entry = "default"
+duration = "1s"
+[[kiosk.playlist]]
+name = "triangle"
+entry = "tri.obj"
+duration = "1s"
+)"));
+  h.run(2);
+  ASSERT_EQ(h.item(), "cube");
+  const std::size_t base = h.renderer().textures().size();
+  EXPECT_NE(h.renderer().textures().find("plain"), nullptr);
+  h.run(32);  // one second on: the next item
+  ASSERT_EQ(h.item(), "triangle");
+  EXPECT_EQ(h.renderer().textures().size(), base + 1) << "the model's map is uploaded while it plays";
+  for (int round = 0; round < 3; ++round) {
+    h.run(31);
+    ASSERT_EQ(h.item(), "cube");
+    EXPECT_EQ(h.renderer().textures().size(), base) << "its map leaves with it (round " << round << ")";
+    EXPECT_NE(h.renderer().textures().find("plain"), nullptr) << "the manifest's texture stays";
+    h.run(31);
+    ASSERT_EQ(h.item(), "triangle");
+    EXPECT_EQ(h.renderer().textures().size(), base + 1) << "and comes back when it plays again";
+  }
 }
 
 }  // namespace

@@ -1,18 +1,21 @@
-// A day of unattended running in seconds: the default show in a playlist with the
-// attract loop, opening hours and idle time-outs, a dial box playing a looping trace of a
-// visitor's turns and presses, a movie texture (whose stream this build lacks, so its fallback
-// path runs), crash-recovery saves, and the status server asked for /health, /metrics and
-// /snapshot.png every simulated hour; 24 hours on a ManualClock at one frame per 10 s of show
-// time (43,200 frames). Resident memory and open file descriptors are sampled every hour and must
-// stay flat once the day's first opening (08:00) has drawn the cube and filled the caches.
-// The dial trace is the synthetic twin's looping script (the replay backend of recorded traces
-// is not on this branch); the movie part is only the stream-absent path for the same reason.
+// A day of unattended running in seconds: the default show in a playlist with the attract
+// loop, opening hours and idle time-outs; a dial box replaying a real recording (the Huion
+// Keydial mini's knob and play/pause key from ../shared/testdata/hid, put in a trace folder by
+// the test and looped); a real movie (a VP9 clip the test records with media's recorder)
+// looping on a texture all day and playing as a playlist item; crash-recovery saves; and the
+// status server asked for /health, /metrics, / and /snapshot.png every simulated hour. 24 hours
+// on a ManualClock at one frame per 4 s of show time (21,600 frames). Resident memory and open
+// file descriptors are sampled every hour and must stay flat once the day's first opening
+// (08:00) has drawn the cube and filled the caches.
 // Example failures: a string or vector that grows with every item change or every request; a
-// state file or socket descriptor opened per save or per request and never closed.
+// state file or socket descriptor opened per save or per request and never closed; a GStreamer
+// pipeline, buffer or texture leaked per loop of the movie or per start of the movie item.
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
 #include <httplib.h>
+#include <malloc.h>
 #include <unistd.h>
 
 #include <array>
@@ -28,7 +31,9 @@
 #include "kiosk/state_store.h"
 #include "kiosk/status_board.h"
 #include "kiosk/status_server.h"
+#include "kiosk/stream_factories.h"
 #include "kiosk/time_zone.h"
+#include "media/recorder.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/event_loop.h"
@@ -44,6 +49,10 @@ std::size_t residentBytes() {
   statm >> pages >> resident;
   return resident * static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
 }
+
+/// Bytes malloc has handed out and not had back, over every arena (and its mmapped blocks): what a
+/// leak grows. Resident memory also moves when a thread's malloc arena takes another heap.
+std::size_t heapInUse() { return ::mallinfo2().uordblks + ::mallinfo2().hblkhd; }
 
 std::size_t openFds() {
   std::size_t n = 0;
@@ -64,13 +73,26 @@ std::size_t settledFds(std::size_t expected) {
   return n;
 }
 
+/// What the open descriptors are, for a failure message.
+std::string describeFds() {
+  std::string out;
+  for (const auto& e : std::filesystem::directory_iterator("/proc/self/fd")) {
+    std::error_code ec;
+    out += e.path().filename().string() + "=" + std::filesystem::read_symlink(e.path(), ec).string() + " ";
+  }
+  return out;
+}
+
 /// Notes every kiosk mode the day went through.
 class ModeWatcher final : public FrameParticipant {
  public:
   explicit ModeWatcher(const ShowDirector& director) : director_(director) {}
   void afterPresent(const FrameContext& /*frame*/) override {
     seen_[static_cast<std::size_t>(director_.policy()->current().mode)] = true;
+    const auto* item = director_.policy()->current().item;
+    if (item && item->name == "clip") playedClip_ = true;
   }
+  [[nodiscard]] bool playedClip() const { return playedClip_; }
   [[nodiscard]] std::set<std::string> seen() const {
     std::set<std::string> out;
     for (std::size_t i = 0; i < seen_.size(); ++i) {
@@ -82,17 +104,75 @@ class ModeWatcher final : public FrameParticipant {
  private:
   const ShowDirector& director_;
   std::array<bool, 3> seen_{};
+  bool playedClip_ = false;
 };
+
+/// A trace folder replaying the Huion Keydial mini recording's second device (D:1, the one that
+/// sends: its knob arrives as a mouse wheel, its key as Consumer Play/Pause).
+bool writeKeydialTrace(const std::filesystem::path& folder, std::string& why) {
+  const std::filesystem::path source = test::testdataDir() / "hid/udev-hid-bpf/huion_keydial_mini050_bluetooth.hid";
+  std::ifstream in(source);
+  if (!in) {
+    why = "no " + source.string() + " (../shared/testdata is not here)";
+    return false;
+  }
+  std::filesystem::create_directories(folder);
+  std::ofstream hid(folder / "dials.hid");
+  std::string line;
+  bool second = false;
+  while (std::getline(in, line)) {
+    if (line.starts_with("D:")) second = line == "D:1";
+    if (second && !line.starts_with("D:")) hid << line << "\n";
+  }
+  std::ofstream(folder / "trace.toml") << "format = 1\nfps = 60\n\n[[device]]\nname = \"dials\"\nkind = \"dial box\"\n"
+                                          "file = \"dials.hid\"\ndevice = \"Keydial mini-050\"\nvendor = \"256c\"\n"
+                                          "product = \"8251\"\n";
+  return true;
+}
+
+/// A six-second VP9 clip at one frame a second, each frame another colour.
+bool recordClip(const std::filesystem::path& file, std::string& why) {
+  media::RecorderOptions options;
+  options.path = file;
+  options.width = 32;
+  options.height = 32;
+  options.fps = 1;
+  auto recorder = media::Recorder::create(options);
+  if (!recorder) {
+    why = recorder.error().describe();
+    return false;
+  }
+  Image frame;
+  frame.width = 32;
+  frame.height = 32;
+  frame.channels = 4;
+  for (int i = 0; i < 6; ++i) {
+    frame.pixels.assign(32 * 32 * 4, 255);
+    for (std::size_t p = 0; p < frame.pixels.size(); p += 4) frame.pixels[p + static_cast<std::size_t>(i % 3)] = 40;
+    if (auto r = (*recorder)->push(frame); !r) {
+      why = r.error().describe();
+      return false;
+    }
+  }
+  if (auto r = (*recorder)->finish(); !r) {
+    why = r.error().describe();
+    return false;
+  }
+  return true;
+}
 
 TEST(Soak, ADayOfTheDefaultShowStaysFlat) {
   auto output = render::createHeadlessOutput({48, 48});
   if (!output) GTEST_SKIP() << "no headless EGL here: " << output.error().describe();
   auto renderer = render::Renderer::create();
   ASSERT_TRUE(renderer);
+  registerShowFactories();  // the replay dial box, the movie stream and the movie item
 
   const auto dir = test::scratchDir("soak");
+  std::string why;
+  if (!writeKeydialTrace(dir / "keydial.trace", why)) GTEST_SKIP() << why;
+  ASSERT_TRUE(recordClip(dir / "clip.webm", why)) << why;
   std::filesystem::copy_file(test::sourceDir() / "configs/shows/video-wall/screens.png", dir / "bars.png");
-  std::filesystem::copy_file(test::sourceDir() / "configs/shows/video-wall/clips/loop.webm", dir / "loop.webm");
   std::ofstream(dir / "show.toml") << R"(
 [show]
 name = "Soak"
@@ -100,22 +180,18 @@ entry = "default"
 
 [devices.dials]
 kind = "dial_box"
-backend = "synthetic"
+backend = "replay"
+trace = "keydial.trace"
 loop = true
-script = [
-  { at = "40s", dial = 0, turns = 0.1 }, { at = "41s", dial = 1, turns = -0.2 }, { at = "42s", dial = 3, turns = 0.05 },
-  { at = "50s", button = 0 }, { at = "51s", button = 0, pressed = false },
-  { at = "25m", dial = 2, turns = 0.3 },
-]
 
 [[bindings]]
 device = "dials"
-button = 0
-action = "next"
+dial = 0
+action = "rotate_y"
 
 [media.loop]
 kind = "movie"
-file = "loop.webm"
+file = "clip.webm"
 
 [textures."screens.png"]
 source = "loop"
@@ -132,12 +208,17 @@ entry = "black"
 duration = "3m"
 
 [[kiosk.playlist]]
+name = "clip"
+entry = "clip.webm"
+duration = "4m"
+
+[[kiosk.playlist]]
 name = "cube again"
 entry = "default"
 duration = "7m"
 
 [kiosk.attract]
-idle_timeout = "90s"
+idle_timeout = "3m"
 items = [ { entry = "default", name = "attract" } ]
 
 [kiosk.schedule]
@@ -157,7 +238,7 @@ requests_per_second = 1000
   ManualClock clock(Nanos{0}, midnight);
   auto loop = runtime::EventLoop::create(clock);
   ASSERT_TRUE(loop);
-  StatusBoard board(midnight, 0.5);
+  StatusBoard board(midnight, 0.25);
   runtime::EventLoop* eventLoop = loop->get();
   board.setWake([eventLoop] { eventLoop->wake(); });
   BoundedQueue<Event> events(1024, [eventLoop] { eventLoop->wake(); });
@@ -170,18 +251,21 @@ requests_per_second = 1000
 
   runtime::Show show;
   ShowDirector director(
-      DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, state->get(), 0.5});
+      DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, state->get(), 0.25});
   director.install(std::move(*loaded), clock.now(), std::nullopt);
   FrameMetrics metrics(board, &events);
   ModeWatcher modes(director);
 
-  // An hour at a time: 1800 frames of 2 s.
+  // An hour at a time: 900 frames of 4 s.
   constexpr int kHours = 24;
   std::vector<std::size_t> rss;
   std::vector<std::size_t> fds;
+  std::vector<std::size_t> heap;
+  std::vector<std::size_t> mmapped;  // the part of heap in large mmapped blocks
+  std::vector<std::string> fdLists;  // what was open when the count was over the bound
   httplib::Client client("127.0.0.1", (*server)->port());
   for (int hour = 0; hour < kHours; ++hour) {
-    FrameLoop frameLoop({0.5, 1800}, clock, &clock, **loop, show, **output, **renderer);
+    FrameLoop frameLoop({0.25, 900}, clock, &clock, **loop, show, **output, **renderer);
     frameLoop.addParticipant(metrics);
     frameLoop.addParticipant(director);
     frameLoop.addParticipant(modes);
@@ -201,25 +285,57 @@ requests_per_second = 1000
     for (int i = 0; i < 2000 && board.snapshotRequests().size() == 0; ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
-    FrameLoop one({0.5, 1}, clock, &clock, **loop, show, **output, **renderer);
+    FrameLoop one({0.25, 1}, clock, &clock, **loop, show, **output, **renderer);
     one.addParticipant(metrics);
     one.addParticipant(director);
     ASSERT_TRUE(one.run());
     snapshot.join();
     (*state)->flush();
     rss.push_back(residentBytes());
+    heap.push_back(heapInUse());
+    mmapped.push_back(::mallinfo2().hblkhd);
     fds.push_back(fds.empty() ? openFds() : settledFds(fds.front()));
+    if (fds.back() > fds[std::min<std::size_t>(fds.size() - 1, 2)] + 8)
+      fdLists.push_back(fmt::format("hour {}: {}", hour, describeFds()));
   }
-  EXPECT_EQ(modes.seen(), (std::set<std::string>{"active", "attract", "closed"})) << "the day went through every mode";
+  EXPECT_EQ(modes.seen(), (std::set<std::string>{"active", "attract", "closed"}))
+      << "the day went through every mode (active: the replayed knob and key woke the attract loop)";
+  const StatusSnapshot status = board.snapshot(midnight);
+  ASSERT_EQ(status.devices.size(), 1u);
+  EXPECT_EQ(status.devices[0].state, "live") << status.devices[0].message;
+  ASSERT_EQ(status.streams.size(), 1u);
+  EXPECT_EQ(status.streams[0].state, "playing") << status.streams[0].message;
+  EXPECT_NE(status.streams[0].message.find("loops"), std::string::npos) << status.streams[0].message;
+  EXPECT_TRUE(modes.playedClip()) << "the movie item played";
   // Flat after the warm-up: the first opening at 08:00 draws the cube (shaders, meshes, the GL
   // driver's buffers) and the log's ring of recent records fills; from 09:00 on nothing grows.
-  // 256 KiB over 14 hours is 6 bytes a frame: a per-frame leak of any size fails this.
+  // Mesa's llvmpipe takes a 1 MiB block for its caches once in a while, on its own schedule (a
+  // mmap catchpoint in gdb shows it under Renderer::drawSurface, late in the day): large mmapped
+  // blocks may grow by at most 1.1 MiB; the rest of the heap in use, where every small object
+  // lives, by at most 256 KiB over 14 hours (12 bytes a frame), so that a leak per frame, per movie
+  // loop or per request fails.
+  const auto small = [&](std::size_t h) {
+    return static_cast<std::ptrdiff_t>(heap[h]) - static_cast<std::ptrdiff_t>(mmapped[h]);
+  };
+  EXPECT_LE(small(heap.size() - 1) - small(9), std::ptrdiff_t{256} * 1024)
+      << "the heap in use (without large blocks) grew by " << (small(heap.size() - 1) - small(9)) / 1024
+      << " KiB from 09:00 to midnight";
+  EXPECT_LE(mmapped.back(), mmapped[9] + std::size_t{1126} * 1024)
+      << "large blocks grew by " << (mmapped.back() - mmapped[9]) / 1024 << " KiB";
   const std::size_t baseline = rss[9];
   const std::size_t highest = *std::max_element(rss.begin() + 9, rss.end());
-  EXPECT_LE(rss.back(), baseline + std::size_t{256} * 1024)
+  EXPECT_LE(rss.back(), baseline + std::size_t{2048} * 1024)
       << "resident memory grew by " << (rss.back() - baseline) / 1024 << " KiB from 09:00 to midnight";
-  EXPECT_LE(highest, baseline + std::size_t{1536} * 1024) << "a peak of " << (highest - baseline) / 1024 << " KiB";
-  for (int hour = 2; hour < kHours; ++hour) EXPECT_EQ(fds[static_cast<std::size_t>(hour)], fds[2]) << "hour " << hour;
+  EXPECT_LE(highest, baseline + std::size_t{3072} * 1024) << "a peak of " << (highest - baseline) / 1024 << " KiB";
+  // GStreamer's pipelines open and close socket pairs as the clips loop and the item restarts, so
+  // the count at a given moment varies by a few; a descriptor leaked per loop (every 6 s) or
+  // per request would add hundreds an hour.
+  for (int hour = 2; hour < kHours; ++hour) {
+    EXPECT_LE(fds[static_cast<std::size_t>(hour)], fds[2] + 8) << "hour " << hour;
+  }
+  if (!fdLists.empty()) {
+    for (const std::string& l : fdLists) std::printf("soak: %s\n", l.c_str());
+  }
   const FrameFigures figures = board.frameFigures();
   EXPECT_GT(figures.frames, 0);
   RecordProperty("rss_first_kib", static_cast<int>(rss.front() / 1024));
@@ -228,9 +344,18 @@ requests_per_second = 1000
   std::string series;
   for (const std::size_t r : rss) series += std::to_string(r / 1024) + " ";
   std::printf("soak: resident KiB by hour: %s\n", series.c_str());
+  series.clear();
+  for (const std::size_t h : heap) series += std::to_string(h / 1024) + " ";
+  std::printf("soak: heap in use KiB by hour: %s\n", series.c_str());
+  series.clear();
+  for (const std::size_t h : mmapped) series += std::to_string(h / 1024) + " ";
+  std::printf("soak: of which mmapped blocks, KiB: %s\n", series.c_str());
+  series.clear();
+  for (const std::size_t n : fds) series += std::to_string(n) + " ";
+  std::printf("soak: open descriptors by hour: %s\n", series.c_str());
   std::printf(
       "soak: 24 simulated hours, %lld frames; resident %zu KiB at 09:00, %zu KiB at midnight (highest %zu "
-      "KiB); %zu open descriptors throughout\n",
+      "KiB); %zu open descriptors at midnight\n",
       static_cast<long long>(figures.frames), baseline / 1024, rss.back() / 1024, highest / 1024, fds.back());
 }
 

@@ -41,8 +41,10 @@ struct ShowFolder {
     writeFile(dir / "wall.sce", "import wall.obj\n");
     writeFile(dir / "wall.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     writeFile(dir / "room.cave", "facet[2]\n");
-    writeFile(dir / "clips" / "loop.webm", "not really a movie");
-    writeFile(dir / "site.trace" / "trace.toml", "fps = 60\n");
+    fs::create_directories(dir / "clips");
+    fs::copy_file(test::sourceDir() / "configs/shows/video-wall/clips/loop.webm", dir / "clips" / "loop.webm");
+    writeFile(dir / "clips" / "broken.webm", "not really a movie");
+    writeFile(dir / "site.trace" / "trace.toml", "format = 1\nfps = 60\n");
     fs::create_directories(dir / "empty.trace");
     fs::copy_file(test::sourceDir() / "configs/shows/camera-sculpture/camera.png", dir / "offline.png");
   }
@@ -251,10 +253,51 @@ TEST(ManifestErrors, EntriesMustBeSomethingAShowPlays) {
   ASSERT_TRUE(ok.manifest) << ok.text;
   EXPECT_EQ(ok.manifest->entry.kind, EntryKind::kScene);
   EXPECT_EQ(ok.text.find("contents are not checked"), std::string::npos) << "scenes are parsed: " << ok.text;
-  const auto movie = f.read("[show]\nentry = \"clips/loop.webm\"\n");
-  ASSERT_TRUE(movie.manifest) << movie.text;
-  EXPECT_NE(movie.text.find("note: show.entry: 'loop.webm' exists; its contents are not checked"), std::string::npos)
-      << "files without a checker say so: " << movie.text;
+}
+
+// Makes sure `basalt check` reads the movies a manifest names with GStreamer (bounded in time)
+// and reports a file it cannot play at the manifest line that names it; a real clip passes.
+// Example failure: a text file renamed .webm passes the check and fails on the wall.
+TEST(ManifestErrors, MoviesAreReadByGStreamer) {
+  ShowFolder f("movies");
+  const auto bad = f.read("[show]\nentry = \"clips/broken.webm\"\n");
+  EXPECT_FALSE(bad.manifest) << bad.text;
+  EXPECT_TRUE(hasError(bad, 2, "show.entry: clips/broken.webm: cannot be read as a movie")) << bad.text;
+  EXPECT_NE(bad.text.find("show.toml:2: show.entry: clips/broken.webm: "), std::string::npos) << bad.text;
+  const auto media = f.read("[media.m]\nkind = \"movie\"\nfile = \"clips/broken.webm\"\n");
+  EXPECT_TRUE(hasError(media, 3, "media.m.file: clips/broken.webm: ")) << media.text;
+  const auto ok = f.read("[show]\nentry = \"clips/loop.webm\"\n");
+  ASSERT_TRUE(ok.manifest) << ok.text;
+  EXPECT_EQ(ok.text.find("contents are not checked"), std::string::npos) << ok.text;
+  EXPECT_EQ(ok.diagnostics.errorCount(), 0u) << ok.text;
+}
+
+// Makes sure replay traces a manifest names are read by the trace reader: a damaged trace.toml
+// or recording is reported with its own file and line, and a trace recorded from the real
+// Surface Dial recording (../shared/testdata/hid) passes. Example failure: a trace folder that
+// only has to contain a file called trace.toml.
+TEST(ManifestErrors, ReplayTracesAreReadByTheTraceReader) {
+  ShowFolder f("traces");
+  const fs::path dial = test::testdataDir() / "hid/udev-hid-bpf/microsoft_surface_dial_rdesc.hid";
+  if (!fs::exists(dial)) GTEST_SKIP() << "no " << dial << " (../shared/testdata is not here)";
+  writeFile(f.dir / "bad.trace" / "trace.toml", "format = 1\nfps = sixty\n");
+  const auto bad = f.read("[devices.d]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"bad.trace\"\n");
+  EXPECT_FALSE(bad.manifest) << bad.text;
+  EXPECT_NE(bad.text.find("bad.trace/trace.toml:2: "), std::string::npos) << bad.text;
+
+  const std::string device = "\n[[device]]\nname = \"dials\"\nkind = \"dial box\"\nfile = \"dials.hid\"\n";
+  writeFile(f.dir / "torn.trace" / "trace.toml", "format = 1\nfps = 60\n" + device);
+  writeFile(f.dir / "torn.trace" / "dials.hid", "R: 4 05 01 09\nE: 0.000001 2 zz 00\n");
+  const auto torn = f.read("[devices.d]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"torn.trace\"\n");
+  EXPECT_FALSE(torn.manifest) << torn.text;
+  EXPECT_NE(torn.text.find("torn.trace/dials.hid"), std::string::npos) << torn.text;
+
+  fs::create_directories(f.dir / "dial.trace");
+  fs::copy_file(dial, f.dir / "dial.trace" / "dials.hid");
+  writeFile(f.dir / "dial.trace" / "trace.toml", "format = 1\nfps = 60\n" + device);
+  const auto ok = f.read("[devices.d]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"dial.trace\"\n");
+  ASSERT_TRUE(ok.manifest) << ok.text;
+  EXPECT_EQ(ok.diagnostics.errorCount(), 0u) << ok.text;
 }
 
 TEST(ManifestErrors, ReferencedFilesAreParsedByTheirChecker) {
