@@ -1,6 +1,7 @@
 #include "kiosk/frame_loop.h"
 
 #include <chrono>
+#include <functional>
 #include <optional>
 
 #include <fmt/format.h>
@@ -33,8 +34,15 @@ Result<void> FrameLoop::renderFrame(FrameContext& context) {
   }
   if (auto r = output_.beginFrame(); !r) return r;
   const render::Size size = output_.size();
-  const auto adjust = [&](runtime::ViewTransforms& view) {
-    for (FrameParticipant* p : participants_) p->adjustView(context, view, size);
+  // The view adjustment reaches the renderer as a std::function: its lambda captures one pointer,
+  // which std::function keeps in place (a larger capture would allocate on every frame).
+  struct Adjustment {
+    FrameLoop* loop;
+    FrameContext* context;
+    render::Size size;
+  } adjustment{this, &context, size};
+  const std::function<void(runtime::ViewTransforms&)> adjust = [a = &adjustment](runtime::ViewTransforms& view) {
+    for (FrameParticipant* p : a->loop->participants_) p->adjustView(*a->context, view, a->size);
   };
   if (viewDrawer_) {
     viewDrawer_->drawViews(show_, size, adjust);
