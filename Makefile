@@ -6,7 +6,7 @@
 #   make bench      build and run the benchmarks, printing their figures
 #   make lint       clang-format and clang-tidy, as CI checks them
 #   make format     reformat the sources with clang-format
-#   make sanitize   build with AddressSanitizer + UBSan and run the unit, contract, render, media, script and fuzz tiers
+#   make sanitize   build with AddressSanitizer + UBSan and run the unit, contract, render, media, script and fuzz tiers (the two day-long soaks run in make test only)
 #   make fuzz       build the libFuzzer targets with clang-19 and run each for FUZZ_SECONDS
 #   make vlab       build and run the virtual-lab tests (qemu with real kernel drivers) alone
 #   make vlab-shell an interactive shell inside the virtual lab, with the build tree
@@ -52,7 +52,7 @@ sanitize: setup
 	@cmake --build $(BUILD)-sanitize
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-	  scripts/run-tests.sh $(BUILD)-sanitize -L 'unit|contract|render|script|fuzz|media'
+	  scripts/run-tests.sh $(BUILD)-sanitize -L 'unit|contract|render|script|fuzz|media' -E '^Soak\.'
 
 fuzz: setup
 	@scripts/fuzz.sh $(FUZZ_SECONDS)
