@@ -129,7 +129,8 @@ void TestPicture::renderPlanar(std::uint32_t counter, int brightness, Yuv422Plan
     const std::uint32_t left = l.x0 + i * 6 * s;
     for (std::uint32_t row = 0; row < 7; ++row) {
       for (std::uint32_t col = 0; col < 5; ++col) {
-        if ((glyph[row] >> (4 - col)) & 1U) fillRect(out, left + col * s, top + row * s, s, s, white);
+        if ((static_cast<std::uint32_t>(glyph[row]) >> (4U - col)) & 1U)
+          fillRect(out, left + col * s, top + row * s, s, s, white);
       }
     }
   }
