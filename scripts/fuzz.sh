@@ -18,6 +18,11 @@ cmake --build "$build" --target "${fuzzers[@]}"
 status=0
 for f in "${fuzzers[@]}"; do
   name=${f%_fuzzer}
+  # FUZZ_SKIP="a b": targets with a known, open finding (ARCHITECTURE "Known problems").
+  if [[ " ${FUZZ_SKIP:-} " == *" $name "* ]]; then
+    echo "== fuzz: $name skipped (FUZZ_SKIP: a known finding is open)"
+    continue
+  fi
   corpus="$top/tests/fuzz/corpus/$name"
   work="$build/corpus/$name"
   crashes="$build/crashes/$name"
