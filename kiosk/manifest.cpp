@@ -295,6 +295,101 @@ Result<std::filesystem::path> confinePath(const std::filesystem::path& folder, s
 
 namespace {
 
+/// Where a manifest has a non-ASCII character that TOML does not allow, or that the TOML reader
+/// Basalt builds with (toml++ 3.3) cannot look at safely: outside quotes and comments (invalid
+/// TOML, and toml++'s whitespace test has undefined behaviour for most such characters), right
+/// after a backslash in a multi-line basic string, or first after a line-ending backslash.
+struct NonAsciiSpot {
+  int line = 0;
+  int column = 0;
+};
+
+std::optional<NonAsciiSpot> misplacedNonAscii(std::string_view text) {
+  enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
+  In in = In::kCode;
+  int line = 1;
+  std::size_t lineStart = 0;
+  const auto spot = [&](std::size_t at) {
+    int column = 1;
+    for (std::size_t i = lineStart; i < at; ++i) column += (static_cast<unsigned char>(text[i]) & 0xC0) != 0x80;
+    return NonAsciiSpot{line, column};
+  };
+  const auto quotes = [&](std::size_t at, char q) {
+    std::size_t n = 0;
+    while (at + n < text.size() && text[at + n] == q) ++n;
+    return n;
+  };
+  std::size_t i = text.starts_with("\xEF\xBB\xBF") ? 3 : 0;
+  while (i < text.size()) {
+    const char c = text[i];
+    const bool high = (static_cast<unsigned char>(c) & 0x80) != 0;
+    if (c == '\n') {
+      ++line;
+      lineStart = i + 1;
+      if (in != In::kMultiBasic && in != In::kMultiLiteral) in = In::kCode;
+      ++i;
+      continue;
+    }
+    switch (in) {
+      case In::kCode:
+        if (high) return spot(i);
+        if (c == '#') {
+          in = In::kComment;
+        } else if (c == '"' || c == '\'') {
+          const bool multi = quotes(i, c) >= 3;
+          in = c == '"' ? (multi ? In::kMultiBasic : In::kBasic) : (multi ? In::kMultiLiteral : In::kLiteral);
+          i += multi ? 3 : 1;
+          continue;
+        }
+        break;
+      case In::kComment: break;
+      case In::kBasic:
+        if (c == '\\') {
+          i += 2;
+          continue;
+        }
+        if (c == '"') in = In::kCode;
+        break;
+      case In::kLiteral:
+        if (c == '\'') in = In::kCode;
+        break;
+      case In::kMultiBasic:
+      case In::kMultiLiteral: {
+        const char q = in == In::kMultiBasic ? '"' : '\'';
+        if (in == In::kMultiBasic && c == '\\') {
+          std::size_t next = i + 1;
+          if (next < text.size() && (static_cast<unsigned char>(text[next]) & 0x80) != 0) return spot(next);
+          if (next < text.size() &&
+              (text[next] == ' ' || text[next] == '\t' || text[next] == '\r' || text[next] == '\n')) {
+            while (next < text.size() &&
+                   (text[next] == ' ' || text[next] == '\t' || text[next] == '\r' || text[next] == '\n')) {
+              if (text[next] == '\n') {
+                ++line;
+                lineStart = next + 1;
+              }
+              ++next;
+            }
+            if (next < text.size() && (static_cast<unsigned char>(text[next]) & 0x80) != 0) return spot(next);
+            i = next;
+          } else {
+            i = next + 1;
+          }
+          continue;
+        }
+        if (c == q) {
+          const std::size_t n = quotes(i, q);
+          if (n >= 3) in = In::kCode;  // up to two more quotes belong to the string
+          i += n;
+          continue;
+        }
+        break;
+      }
+    }
+    ++i;
+  }
+  return std::nullopt;
+}
+
 // LAVA's dial table has a default action for dials 0 to 7.
 constexpr std::uint16_t kLavaDials = 8;
 
@@ -382,6 +477,13 @@ class Reader {
       diags_.error(
           shown_, 0,
           fmt::format("the manifest is {} bytes; a show.toml is at most {} bytes", text.size(), kMaxManifestBytes));
+      return std::nullopt;
+    }
+    if (const auto bad = misplacedNonAscii(text)) {
+      diags_.error(shown_, bad->line,
+                   fmt::format("not valid TOML: a non-ASCII character at column {} outside quotes or a comment (or "
+                               "right after a backslash in a \"\"\" string); put text in quotes",
+                               bad->column));
       return std::nullopt;
     }
     toml::parse_result parsed = toml::parse(text, file_.string());
@@ -1253,7 +1355,7 @@ class Reader {
           b.gain = *gain;
           b.gainGiven = true;
         }
-        if (auto acceleration = number(*t, "acceleration", path, 0, 1e3)) b.acceleration = *acceleration;
+        if (auto acceleration = number(*t, "acceleration", path, 0, 1e3)) b.acceleration = acceleration;
         if (auto invert = boolean(*t, "invert", path)) b.invert = *invert;
         if (b.action == runtime::Action::kNone && (t->get("gain") || t->get("acceleration") || t->get("invert"))) {
           warning(b.line, fmt::format("{}: dial {} does nothing, so its gain, acceleration and invert do nothing", path,

@@ -140,7 +140,7 @@ std::optional<ResumePoint> StateStore::load() const {
   std::ostringstream text;
   text << in.rdbuf();
   const std::string content = text.str();
-  if (content.size() > 64 * 1024) {
+  if (content.size() > std::size_t{64} * 1024) {
     log::warn(kLogState, "ignoring the saved state {}: it is too large; the show starts from the beginning", file_);
     return std::nullopt;
   }

@@ -196,6 +196,26 @@ class MtlParser {
     std::size_t nameStart = std::string_view::npos, nameEnd = 0;
     for (std::size_t i = 0; i < tokens.size();) {
       const std::string_view t = tokens[i].text;
+      // A quoted name ("my texture -old.png", as Basalt writes names that would not read back
+      // otherwise) is one name: blanks and dashes inside are part of it. It ends at a quote
+      // followed by a blank or the end of the line.
+      if (t.front() == '"') {
+        std::size_t close = tokens[i].offset + 1;
+        while (true) {
+          close = content.find('"', close);
+          if (close == std::string_view::npos || close + 1 >= content.size() || isBlank(content[close + 1]) ||
+              content[close + 1] == '\r') {
+            break;
+          }
+          ++close;
+        }
+        if (close != std::string_view::npos) {
+          if (nameStart == std::string_view::npos) nameStart = tokens[i].offset;
+          nameEnd = close + 1;
+          while (i < tokens.size() && tokens[i].offset <= close) ++i;
+          continue;
+        }
+      }
       const OptionSpec* spec = nullptr;
       if (t.size() > 1 && t[0] == '-') {
         for (const OptionSpec& o : kTextureOptions) {
@@ -277,6 +297,21 @@ Result<std::vector<runtime::Material>> readMtlFile(const std::filesystem::path& 
   return materials;
 }
 
+namespace {
+
+/// A map's file name as an MTL line can carry it: quoted when, as it stands, it would read back
+/// as another name (blanks at either end, a word the reader would take for an option, quotes).
+std::string mapReference(const std::filesystem::path& target, const std::filesystem::path& folder) {
+  std::string name = relativeReference(target, folder);
+  bool quote = !name.empty() && (isBlank(name.front()) || isBlank(name.back()) || name.front() == '"');
+  for (std::size_t i = 0; i < name.size() && !quote; ++i) {
+    quote = name[i] == '-' && (i == 0 || isBlank(name[i - 1]));
+  }
+  return quote ? '"' + name + '"' : name;
+}
+
+}  // namespace
+
 std::string formatMtl(const std::vector<runtime::Material>& materials, const std::filesystem::path& folder) {
   std::string out = "# Material library written by Basalt\n";
   for (const runtime::Material& m : materials) {
@@ -285,10 +320,10 @@ std::string formatMtl(const std::vector<runtime::Material>& materials, const std
                        formatColour(m.specular));
     if (m.emissive != runtime::Color3{0, 0, 0}) out += fmt::format("Ke {}\n", formatColour(m.emissive));
     out += fmt::format("Ns {}\nd {}\n", formatFloat(m.shininess), formatFloat(m.opacity));
-    if (!m.diffuseMap.empty()) out += fmt::format("map_Kd {}\n", relativeReference(m.diffuseMap, folder));
-    if (!m.bumpMap.empty()) out += fmt::format("map_bump {}\n", relativeReference(m.bumpMap, folder));
-    if (!m.reflectionMap.empty()) out += fmt::format("refl {}\n", relativeReference(m.reflectionMap, folder));
-    if (!m.alphaMap.empty()) out += fmt::format("map_d {}\n", relativeReference(m.alphaMap, folder));
+    if (!m.diffuseMap.empty()) out += fmt::format("map_Kd {}\n", mapReference(m.diffuseMap, folder));
+    if (!m.bumpMap.empty()) out += fmt::format("map_bump {}\n", mapReference(m.bumpMap, folder));
+    if (!m.reflectionMap.empty()) out += fmt::format("refl {}\n", mapReference(m.reflectionMap, folder));
+    if (!m.alphaMap.empty()) out += fmt::format("map_d {}\n", mapReference(m.alphaMap, folder));
   }
   return out;
 }

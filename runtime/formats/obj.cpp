@@ -1176,7 +1176,7 @@ Result<LoadedModel> readObjStreamed(const std::filesystem::path& path, const Loa
       return fail(Errc::kUnsupported, "", path.string());
     }
   }
-  std::rewind(file.get());
+  if (std::fseek(file.get(), 0, SEEK_SET) != 0) return fail(Errc::kIo, "cannot seek back to the start", path.string());
   ObjParser parser(path.string(), path.parent_path(), options, true);
   std::string buffer;
   bool first = true, eof = false;

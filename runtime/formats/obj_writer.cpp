@@ -30,8 +30,25 @@ bool exactByte(float v) {
          static_cast<float>(static_cast<int>(scaled)) / 255.0f == v;
 }
 
+/// Writes one Extended OBJ vertex colour: 0..255 integers when exact, otherwise fractions, with a
+/// '.' or an exponent so that the reader takes them as 0..1.
+void appendVertexColour(std::string& out, const Vec4& c) {
+  if (exactByte(c.x) && exactByte(c.y) && exactByte(c.z) && exactByte(c.w)) {
+    fmt::format_to(std::back_inserter(out), "vc {} {} {} {}\n", std::lround(c.x * 255.0f), std::lround(c.y * 255.0f),
+                   std::lround(c.z * 255.0f), std::lround(c.w * 255.0f));
+    return;
+  }
+  const std::size_t start = out.size();
+  fmt::format_to(std::back_inserter(out), "vc {} {} {} {}", c.x, c.y, c.z, c.w);
+  if (std::string_view(out).substr(start).find_first_of(".eE") == std::string_view::npos) out += ".0";
+  out += '\n';
+}
+
 struct Writer {
   std::string out;
+  /// Extended OBJ: colours go on 'vc' lines, one for every vertex of the file. The reader gives
+  /// the n-th 'vc' to the n-th vertex of the whole file, so either every mesh writes them or none.
+  bool vertexColourLines = false;
   std::size_t positionsWritten = 0;
   std::size_t texcoordsWritten = 0;
   std::size_t normalsWritten = 0;
@@ -53,14 +70,11 @@ struct Writer {
     const bool colours = m.colors.size() == count && count > 0;
     const bool texcoords = m.texcoords.size() == count && count > 0;
     const bool normals = m.normals.size() == count && count > 0;
-    bool opaque = true, bytes = true;
+    bool opaque = true;
     if (colours) {
-      for (const Vec4& c : m.colors) {
-        opaque = opaque && c.w == 1.0f;
-        bytes = bytes && exactByte(c.x) && exactByte(c.y) && exactByte(c.z) && exactByte(c.w);
-      }
+      for (const Vec4& c : m.colors) opaque = opaque && c.w == 1.0f;
     }
-    const bool writeVc = extended && colours && bytes && !opaque;
+    const bool writeVc = extended && vertexColourLines;
     const Mat4 normalMatrix = transform ? transform->inverted().transposed() : Mat4{};
     for (std::size_t i = 0; i < count; ++i) {
       const Vec3 p = transform ? transform->transformPoint(m.positions[i]) : m.positions[i];
@@ -78,10 +92,7 @@ struct Writer {
       out += '\n';
     }
     if (writeVc) {
-      for (const Vec4& c : m.colors) {
-        fmt::format_to(std::back_inserter(out), "vc {} {} {} {}\n", std::lround(c.x * 255.0f),
-                       std::lround(c.y * 255.0f), std::lround(c.z * 255.0f), std::lround(c.w * 255.0f));
-      }
+      for (std::size_t i = 0; i < count; ++i) appendVertexColour(out, colours ? m.colors[i] : Vec4{1, 1, 1, 1});
     }
     if (texcoords) {
       for (const Vec2& t : m.texcoords) fmt::format_to(std::back_inserter(out), "vt {} {}\n", t.x, t.y);
@@ -184,6 +195,13 @@ const runtime::Mesh* meshOf(const LoadedModel& model, const ModelObject& object)
 std::string formatObj(const LoadedModel& model, const std::filesystem::path& folder, const ObjWriteOptions& options,
                       const std::string& mtlName, std::string& mtlText) {
   Writer w;
+  if (options.extended) {
+    // Translucent vertex colours anywhere need 'vc' lines (a 'v' line carries r g b only).
+    for (const ModelObject& o : model.objects) {
+      if (!o.mesh || !o.instanceOf.empty()) continue;
+      for (const Vec4& c : o.mesh->colors) w.vertexColourLines = w.vertexColourLines || c.w != 1.0f;
+    }
+  }
   std::string body;
   for (const ModelObject& o : model.objects) {
     w.out.clear();

@@ -410,6 +410,10 @@ ResolvedPath resolveReferencedFile(std::string_view name, const std::filesystem:
     cleaned = cleaned.substr(1, cleaned.size() - 2);
   }
   std::replace(cleaned.begin(), cleaned.end(), '\\', '/');
+  // "a//b" is "a/b" on Linux; lexically_normal() leaves a name of slashes alone ("//"), so a
+  // written-back reference would read as a different path.
+  cleaned.erase(std::unique(cleaned.begin(), cleaned.end(), [](char a, char b) { return a == '/' && b == '/'; }),
+                cleaned.end());
   // "C:/textures/wood.jpg" from another machine: only the last component can mean anything here.
   const bool windowsAbsolute = cleaned.size() >= 3 && cleaned[1] == ':' && cleaned[2] == '/' &&
                                ((cleaned[0] >= 'A' && cleaned[0] <= 'Z') || (cleaned[0] >= 'a' && cleaned[0] <= 'z'));

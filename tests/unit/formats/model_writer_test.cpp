@@ -43,6 +43,7 @@ void expectSameObjects(const LoadedModel& a, const LoadedModel& b, const std::st
       EXPECT_EQ(x.mesh->positions, y.mesh->positions) << what << " " << x.name;
       EXPECT_EQ(x.mesh->triangles, y.mesh->triangles) << what << " " << x.name;
       EXPECT_EQ(x.mesh->parts, y.mesh->parts) << what << " " << x.name;
+      EXPECT_EQ(x.mesh->colors, y.mesh->colors) << what << " " << x.name;
       EXPECT_EQ(x.mesh->materials, y.mesh->materials) << what << " " << x.name;
     }
   }
@@ -84,6 +85,45 @@ TEST(ObjWriter, ExtendedStatementsSurviveTheRoundTrip) {
   expectSameObjects(*model, back, "extended");
   EXPECT_TRUE(back.extended);
   EXPECT_EQ(back.objects[0].colorMap, (dir / "skin.jpg").string());
+}
+
+// 'vc' lines belong to the file's n-th vertex, not the object's: an object with opaque colours
+// before one with translucent ones must not shift them (a fuzzing finding).
+TEST(ObjWriter, TranslucentColoursInALaterObjectStayOnTheirVertices) {
+  const auto dir = basalt::test::scratchDir("obj-vc-later");
+  auto model = parseObjText(
+      "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvc 255 128 64 255\nvc 255 255 255 255\nvc 0 0 0 255\nl 1 2\n"
+      "o b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nvc 10 20 30 40\nvc 0 0 0 0\nvc 0 0 0 0\nf 4 5 6\n"
+      "o c\nv 0 0 2\nv 1 0 2\nv 0 1 2\nvc 1 1 1 1\nvc 0.1 0.2 0.3 0.4\nf 7 8 9\n",
+      (dir / "src.obj").string(), dir, test::quiet());
+  ASSERT_TRUE(model) << model.error().describe();
+  const LoadedModel back = roundTrip(*model, dir, "out.obj");
+  expectSameObjects(*model, back, "colours");
+  ASSERT_EQ(back.objects.size(), 3u);
+  ASSERT_TRUE(back.objects[0].mesh && back.objects[1].mesh && back.objects[2].mesh);
+  EXPECT_EQ(back.objects[0].mesh->colors.at(0), (Vec4{1, 128 / 255.0f, 64 / 255.0f, 1}));
+  EXPECT_EQ(back.objects[1].mesh->colors.at(0), (Vec4{10 / 255.0f, 20 / 255.0f, 30 / 255.0f, 40 / 255.0f}));
+  EXPECT_EQ(back.objects[2].mesh->colors.at(1), (Vec4{0.1f, 0.2f, 0.3f, 0.4f}));
+}
+
+// Texture names with blanks at the ends or words that look like options are quoted in the MTL
+// written, and the reader takes a quoted name whole.
+TEST(ObjWriter, AwkwardTextureNamesAreQuotedAndReadBack) {
+  const auto dir = basalt::test::scratchDir("obj-mtl-names");
+  std::filesystem::create_directories(dir / " art");
+  std::ofstream(dir / " art" / "wood -old.png") << "x";
+  std::ofstream(dir / "a.mtl") << "newmtl wood\nmap_Kd -clamp on \" art/wood -old.png\" -s 1 1 1\n";
+  std::ofstream(dir / "a.obj") << "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl wood\nf 1 2 3\n";
+  auto model = loadModel(dir / "a.obj", test::quiet());
+  ASSERT_TRUE(model);
+  EXPECT_EQ(test::firstMesh(*model).materials.at(0).diffuseMap, (dir / " art" / "wood -old.png").string());
+  ASSERT_TRUE(writeObj(dir / "b.obj", *model));
+  const std::string text = test::readText(dir / "b.mtl");
+  EXPECT_NE(text.find("map_Kd \" art/wood -old.png\""), std::string::npos) << text;
+  auto back = loadModel(dir / "b.obj", test::quiet());
+  ASSERT_TRUE(back);
+  EXPECT_TRUE(back->warnings.empty()) << listWarnings(back->warnings);
+  EXPECT_EQ(test::firstMesh(*back).materials, test::firstMesh(*model).materials);
 }
 
 TEST(ObjWriter, InterleavedGroupsAndMaterialsKeepTheirPartsAndOrder) {
