@@ -3,6 +3,7 @@
 #   scripts/lint.sh [BUILD_DIR]      BUILD_DIR holds compile_commands.json (default: build)
 #   LINT_FIX=1 scripts/lint.sh       rewrites the files with clang-format instead of failing
 #   LINT_TESTS=1 scripts/lint.sh     runs clang-tidy over tests/ too (clang-format always checks them)
+#   LINT_JOBS=N scripts/lint.sh      runs N clang-tidy processes (default: one per core)
 set -uo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$top/build}
@@ -35,7 +36,7 @@ else
   mapfile -t units < <(printf '%s\n' "${sources[@]}" | grep '\.cpp$' | grep -v '^tests/')
 fi
 # Compile commands come from g++; options only g++ knows are ignored by clang.
-if ! printf '%s\n' "${units[@]}" | xargs -P "$(nproc)" -n 4 clang-tidy-19 -p "$build" --quiet \
+if ! printf '%s\n' "${units[@]}" | xargs -P "${LINT_JOBS:-$(nproc)}" -n 4 clang-tidy-19 -p "$build" --quiet \
     --extra-arg=-Wno-unknown-warning-option --extra-arg=-Wno-unused-command-line-argument \
     > "$logs/tidy.log" 2>&1; then
   grep -E 'warning:|error:' "$logs/tidy.log" | sort -u | head -50
