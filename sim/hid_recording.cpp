@@ -1,5 +1,7 @@
-// Reader and writer for hid-tools' hid-recorder text format. Tolerant of what real files contain
-// (comments, blank lines, CRLF, decoded-report comment lines, extra spaces, uppercase hex), strict
+// Reader and writer for hid-tools' hid-recorder text format, used by the replay backend, `basalt
+// record`, manifests and the virtual lab's uhid replay. Tolerant of what real files contain
+// (comments, blank lines, CRLF, decoded-report comment lines, extra spaces, uppercase hex, line
+// types of newer recorders), strict
 // about what would replay wrongly (a length that disagrees with the bytes, a bad hex byte, an
 // event before any descriptor): those are errors naming the line.
 
@@ -172,10 +174,11 @@ Result<HidRecording> parseHidRecording(std::string_view text, std::string_view n
         HidReport r;
         if (w.empty() || !parseTime(w[0], r.time)) return bad("E: needs a time 'seconds.microseconds'");
         if (!parseBytes(w, 1, r.bytes, why)) return bad("E: " + why);
+        if (r.bytes.empty()) return bad("E: an empty input report");
         current->reports.push_back(std::move(r));
         break;
       }
-      default: return bad(fmt::format("unknown line type '{}:'", tag));
+      default: break;  // a line type of a newer recorder: nothing Basalt replays
     }
   }
   std::erase_if(rec.devices, [](const HidRecordedDevice& d) { return d.descriptor.empty() && d.reports.empty(); });

@@ -19,6 +19,7 @@
 
 #include <fmt/format.h>
 
+#include "devices/hid/decoding_dial_box.h"
 #include "devices/hid/dial_decoder.h"
 #include "devices/hid/hid_backend.h"
 
@@ -60,12 +61,10 @@ std::string busOf(hid_bus_type bus) {
   }
 }
 
-class HidrawDialBox final : public DialBox {
+class HidrawDialBox final : public DecodingDialBox {
  public:
   HidrawDialBox(DeviceInfo info, std::vector<std::uint8_t> descriptor, DialDecoder decoder, const Clock& clock)
-      : DialBox(std::move(info), decoder.dialCount(), decoder.buttonCount(), true),
-        decoder_(std::move(decoder)),
-        clock_(clock) {
+      : DecodingDialBox(std::move(info), decoder.dialCount(), decoder.buttonCount(), std::move(decoder), clock) {
     setReportDescriptor(std::move(descriptor));
   }
   ~HidrawDialBox() override { close(); }
@@ -81,45 +80,29 @@ class HidrawDialBox final : public DialBox {
       }
       return fail(Errc::kUnavailable, fmt::format("cannot open: {}", hidError(nullptr)), info().path);
     }
-    decoder_.reset();
     device_ = std::move(dev);
-    stop_.store(false);
-    reader_ = std::thread([this] { readLoop(); });
+    startReader();
     return {};
   }
 
   void doClose() override {
-    stop_.store(true);
-    if (reader_.joinable()) reader_.join();
+    stopReader();
     device_.reset();
   }
 
-  void readLoop() {
+  void readLoop() override {
     std::array<std::uint8_t, 4096> buf{};
-    std::array<Event, DialDecoder::kMaxEventsPerReport> events;
-    while (!stop_.load()) {
+    while (!stopping()) {
       const int n = hid_read_timeout(device_.get(), buf.data(), buf.size(), 100);
       if (n < 0) {
         reportLost(Error(Errc::kDeviceLost, fmt::format("read failed: {}", hidError(device_.get())), info().path));
         return;
       }
-      if (n == 0) continue;
-      const Nanos now = clock_.now();
-      const auto report = std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n));
-      tapReport(now, report);
-      const std::size_t count = decoder_.decode(report, events);
-      for (std::size_t i = 0; i < count; ++i) {
-        events[i].time = now;
-        emit(events[i]);
-      }
+      if (n > 0) handleReport(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(n)));
     }
   }
 
-  DialDecoder decoder_;
-  const Clock& clock_;
   HidDevicePtr device_;
-  std::atomic<bool> stop_{false};
-  std::thread reader_;
 };
 
 }  // namespace

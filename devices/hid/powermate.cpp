@@ -20,6 +20,7 @@
 
 #include <fmt/format.h>
 
+#include "devices/hid/decoding_dial_box.h"
 #include "devices/hid/dial_decoder.h"
 #include "devices/hid/hid_backend.h"
 
@@ -67,12 +68,10 @@ std::string usbNode(libusb_device* dev) {
 const std::vector<std::uint8_t> kFallbackDescriptor = {0x06, 0x00, 0xff, 0x09, 0x01, 0xa1, 0x01, 0x15, 0x00, 0x26, 0xff,
                                                        0x00, 0x75, 0x08, 0x95, 0x06, 0x09, 0x01, 0x81, 0x02, 0xc0};
 
-class PowerMateDialBox final : public DialBox {
+class PowerMateDialBox final : public DecodingDialBox {
  public:
   PowerMateDialBox(DeviceInfo info, const Clock& clock)
-      : DialBox(std::move(info), 1, 1, true),
-        decoder_(*DialDecoder::create(kGriffinVendor, kPowerMateProduct, {})),
-        clock_(clock) {}
+      : DecodingDialBox(std::move(info), 1, 1, *DialDecoder::create(kGriffinVendor, kPowerMateProduct, {}), clock) {}
   ~PowerMateDialBox() override { close(); }
 
  private:
@@ -133,16 +132,13 @@ class PowerMateDialBox final : public DialBox {
       descriptor = kFallbackDescriptor;
     }
     setReportDescriptor(std::move(descriptor));
-    decoder_.reset();
     handle_ = std::move(handle);
-    stop_.store(false);
-    reader_ = std::thread([this] { readLoop(); });
+    startReader();
     return {};
   }
 
   void doClose() override {
-    stop_.store(true);
-    if (reader_.joinable()) reader_.join();
+    stopReader();
     if (handle_) libusb_release_interface(handle_.get(), 0);
     handle_.reset();
   }
@@ -157,10 +153,9 @@ class PowerMateDialBox final : public DialBox {
     return {};
   }
 
-  void readLoop() {
+  void readLoop() override {
     std::array<std::uint8_t, 64> buf{};
-    std::array<Event, DialDecoder::kMaxEventsPerReport> events;
-    while (!stop_.load()) {
+    while (!stopping()) {
       int transferred = 0;
       const int rc = libusb_interrupt_transfer(handle_.get(), endpoint_, buf.data(), static_cast<int>(buf.size()),
                                                &transferred, 100);
@@ -169,23 +164,12 @@ class PowerMateDialBox final : public DialBox {
         reportLost(Error(Errc::kDeviceLost, fmt::format("read failed: {}", libusb_strerror(rc)), info().path));
         return;
       }
-      const Nanos now = clock_.now();
-      const auto report = std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(transferred));
-      tapReport(now, report);
-      const std::size_t n = decoder_.decode(report, events);
-      for (std::size_t i = 0; i < n; ++i) {
-        events[i].time = now;
-        emit(events[i]);
-      }
+      handleReport(std::span<const std::uint8_t>(buf.data(), static_cast<std::size_t>(transferred)));
     }
   }
 
-  DialDecoder decoder_;
-  const Clock& clock_;
   HandlePtr handle_;
   std::uint8_t endpoint_ = 0x81;
-  std::atomic<bool> stop_{false};
-  std::thread reader_;
   std::mutex controlMutex_;  // serialises LED control transfers
 };
 

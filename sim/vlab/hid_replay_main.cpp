@@ -24,7 +24,7 @@
 #include <thread>
 #include <vector>
 
-#include "sim/vlab/hid_recording.h"
+#include "sim/hid_recording.h"
 #include "sim/vlab/uhid_device.h"
 
 namespace {
@@ -107,14 +107,15 @@ int main(int argc, char** argv) {
     return ::sigtimedwait(&stop, nullptr, &now) > 0;
   };
 
-  auto recording = basalt::sim::vlab::readHidRecording(opt.file);
+  auto recording = basalt::sim::readHidRecording(opt.file);
   if (!recording) {
     std::fprintf(stderr, "basalt-vlab-hid-replay: error: %s\n", recording.error().describe().c_str());
     return 1;
   }
   std::vector<UhidDevice> devices;
-  for (std::size_t i = 0; i < recording->size(); ++i) {
-    const auto& rec = (*recording)[i];
+  const std::vector<basalt::sim::HidRecordedDevice>& recorded = recording->devices;
+  for (std::size_t i = 0; i < recorded.size(); ++i) {
+    const auto& rec = recorded[i];
     basalt::sim::vlab::UhidIdentity id;
     id.name = rec.name.empty() ? "Basalt replay " + std::to_string(i) : rec.name;
     id.phys = rec.phys.empty() ? "basalt-vlab-replay/input" + std::to_string(i) : rec.phys;
@@ -152,7 +153,7 @@ int main(int argc, char** argv) {
   }
   if (opt.waitOpen >= 0) {
     for (std::size_t i = 0; i < devices.size(); ++i) {
-      if ((*recording)[i].reports.empty()) continue;
+      if (recorded[i].reports.empty()) continue;
       const auto limit = std::chrono::milliseconds(static_cast<long long>(opt.waitOpen * 1000));
       if (auto ok = devices[i].waitOpened(limit); !ok) {
         std::fprintf(stderr, "basalt-vlab-hid-replay: error: %s\n", ok.error().describe().c_str());
@@ -168,8 +169,8 @@ int main(int argc, char** argv) {
     const std::vector<std::uint8_t>* bytes;
   };
   std::vector<Item> items;
-  for (std::size_t i = 0; i < recording->size(); ++i) {
-    for (const auto& r : (*recording)[i].reports) items.push_back({r.time, i, &r.bytes});
+  for (std::size_t i = 0; i < recorded.size(); ++i) {
+    for (const auto& r : recorded[i].reports) items.push_back({r.time, i, &r.bytes});
   }
   // By time; reports at the same time keep their recorded order (the vector's).
   std::vector<std::size_t> order(items.size());

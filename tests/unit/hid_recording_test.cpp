@@ -1,13 +1,13 @@
-// The HID recording reader used by the virtual lab's uhid replay (sim/vlab/hid_recording.h):
-// hid-recorder's text format, the shared recordings, and malformed input.
+// The HID recording reader (sim/hid_recording.h) that the replay backend and the virtual lab's
+// uhid replay share: hid-recorder's text format, the shared recordings, and malformed input.
 
-#include "sim/vlab/hid_recording.h"
+#include "sim/hid_recording.h"
 
 #include <gtest/gtest.h>
 
 #include "support/test_paths.h"
 
-namespace basalt::sim::vlab {
+namespace basalt::sim {
 namespace {
 
 using namespace std::chrono_literals;
@@ -22,8 +22,9 @@ std::filesystem::path recording(const char* name) {
 TEST(HidRecordingFile, HuionDial2HasThreeDescriptorOnlyDevices) {
   const auto path = recording("huion_dial2_q630m_rdescs.hid");
   if (path.empty()) GTEST_SKIP() << "../shared/testdata is missing (BASALT_TESTDATA)";
-  auto devices = readHidRecording(path);
-  ASSERT_TRUE(devices) << devices.error().describe();
+  auto read = readHidRecording(path);
+  ASSERT_TRUE(read) << read.error().describe();
+  const std::vector<HidRecordedDevice>* devices = &read->devices;
   ASSERT_EQ(devices->size(), 3U);
   EXPECT_EQ((*devices)[0].descriptor.size(), 18U);
   EXPECT_EQ((*devices)[1].descriptor.size(), 93U);
@@ -42,8 +43,9 @@ TEST(HidRecordingFile, HuionDial2HasThreeDescriptorOnlyDevices) {
 TEST(HidRecordingFile, KeydialReportsBelongToTheSecondDevice) {
   const auto path = recording("huion_keydial_mini050_bluetooth.hid");
   if (path.empty()) GTEST_SKIP() << "../shared/testdata is missing (BASALT_TESTDATA)";
-  auto devices = readHidRecording(path);
-  ASSERT_TRUE(devices) << devices.error().describe();
+  auto read = readHidRecording(path);
+  ASSERT_TRUE(read) << read.error().describe();
+  const std::vector<HidRecordedDevice>* devices = &read->devices;
   ASSERT_EQ(devices->size(), 2U);
   EXPECT_EQ((*devices)[0].descriptor.size(), 114U);
   EXPECT_TRUE((*devices)[0].reports.empty());
@@ -63,8 +65,9 @@ TEST(HidRecordingFile, KeydialReportsBelongToTheSecondDevice) {
 TEST(HidRecordingFile, SurfaceDialIsOneDevice) {
   const auto path = recording("microsoft_surface_dial_rdesc.hid");
   if (path.empty()) GTEST_SKIP() << "../shared/testdata is missing (BASALT_TESTDATA)";
-  auto devices = readHidRecording(path);
-  ASSERT_TRUE(devices) << devices.error().describe();
+  auto read = readHidRecording(path);
+  ASSERT_TRUE(read) << read.error().describe();
+  const std::vector<HidRecordedDevice>* devices = &read->devices;
   ASSERT_EQ(devices->size(), 1U);
   EXPECT_EQ((*devices)[0].name, "Surface Dial");
   EXPECT_EQ((*devices)[0].descriptor.size(), 488U);
@@ -83,15 +86,15 @@ TEST(HidRecordingParse, MalformedLinesNameTheLine) {
   };
   const Case cases[] = {
       {"R: 3 05 01\n", "t.hid:1", "says 3 bytes but has 2"},
-      {"R: 2 05 zz\n", "t.hid:1", "'zz' is not a hex byte"},
-      {"R: 1 05\nE: 1.5 1 00\n", "t.hid:2", "SECONDS.MICROSECONDS"},
-      {"R: 1 05\nI: 3 256c\n", "t.hid:2", "BUS VENDOR PRODUCT"},
-      {"R: 1 05\nI: 3 1ffff 1\n", "t.hid:2", "BUS VENDOR PRODUCT"},
-      {"D: 1\nR: 1 05\n", "t.hid:1", "device 1 comes before device 0"},
+      {"R: 2 05 zz\n", "t.hid:1", "'zz' is not a hexadecimal byte"},
+      {"R: 1 05\nE: 1,5 1 00\n", "t.hid:2", "seconds.microseconds"},
+      {"R: 1 05\nI: 3 256c\n", "t.hid:2", "bus vendor product"},
+      {"R: 1 05\nI: 3 1ffff 1\n", "t.hid:2", "bus vendor product"},
       {"R: 1 05\nE: 000001.000000 0\n", "t.hid:2", "empty input report"},
-      {"# nothing\n", "t.hid", "no device"},
-      {"N: named\nE: 000001.000000 1 00\n", "t.hid", "no report descriptor"},
-      {"R: x\n", "t.hid:1", "byte count"},
+      {"# nothing\n", "t.hid", "no R: report descriptor"},
+      {"N: named\nE: 000001.000000 1 00\n", "t.hid:2", "before any R: report descriptor"},
+      {"R: x\n", "t.hid:1", "'x' is not a byte count"},
+      {"R: 1 05\nnot a record\n", "t.hid:2", "unknown line"},
   };
   for (const auto& c : cases) {
     auto parsed = parseHidRecording(c.text, "t.hid");
@@ -110,11 +113,12 @@ TEST(HidRecordingParse, ToleratesCommentsUnknownLinesAndCrlf) {
       "I: 3 1209 0001\r\nE: 000000.500000 2 01 ff\r\n",
       "t.hid");
   ASSERT_TRUE(parsed) << parsed.error().describe();
-  ASSERT_EQ(parsed->size(), 1U);
-  EXPECT_EQ((*parsed)[0].name, "Knob");
-  EXPECT_EQ((*parsed)[0].phys, "usb-1/input0");
-  ASSERT_EQ((*parsed)[0].reports.size(), 1U);
-  EXPECT_EQ((*parsed)[0].reports[0].time, 500ms);
+  ASSERT_EQ(parsed->devices.size(), 1U);
+  const HidRecordedDevice& d = parsed->devices[0];
+  EXPECT_EQ(d.name, "Knob");
+  EXPECT_EQ(d.phys, "usb-1/input0");
+  ASSERT_EQ(d.reports.size(), 1U);
+  EXPECT_EQ(d.reports[0].time, 500ms);
 }
 
 // Makes sure a missing file is a clear error. Example failure: an empty recording is returned.
@@ -126,4 +130,4 @@ TEST(HidRecordingFile, MissingFileIsNotFound) {
 }
 
 }  // namespace
-}  // namespace basalt::sim::vlab
+}  // namespace basalt::sim

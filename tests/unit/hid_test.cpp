@@ -308,13 +308,10 @@ TEST(HidRecordingFormat, ParsesWritesAndRejectsWithLineNumbers) {
   EXPECT_EQ(again->devices[0].descriptor, d.descriptor);
 
   const std::vector<std::pair<std::string, std::string>> bad = {
-      {"E: 0.1 1 00\n", "t.hid:1"},
-      {"R: 2 05\n", "t.hid:1"},
-      {"R: 1 zz\n", "t.hid:1"},
-      {"R: 1 05\nE: x 1 00\n", "t.hid:2"},
-      {"R: 1 05\nQ: what\n", "t.hid:2"},
-      {"# only a comment\n", "t.hid"},
-      {"R: 1 05\nI: 3 nothex 1\n", "t.hid:2"},
+      {"E: 0.1 1 00\n", "t.hid:1"},    {"R: 2 05\n", "t.hid:1"},
+      {"R: 1 zz\n", "t.hid:1"},        {"R: 1 05\nE: x 1 00\n", "t.hid:2"},
+      {"R: 1 05\nwhat\n", "t.hid:2"},  {"R: 1 05\nE: 000001.000000 0\n", "t.hid:2"},
+      {"# only a comment\n", "t.hid"}, {"R: 1 05\nI: 3 nothex 1\n", "t.hid:2"},
   };
   for (const auto& [input, where] : bad) {
     auto r = sim::parseHidRecording(input, "t.hid");

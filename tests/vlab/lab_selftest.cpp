@@ -27,7 +27,7 @@
 #include <gtest/gtest.h>
 
 #include "runtime/unique_fd.h"
-#include "sim/vlab/hid_recording.h"
+#include "sim/hid_recording.h"
 #include "sim/vlab/uhid_device.h"
 #include "sim/vlab/uvc/jpeg_encoder.h"
 #include "sim/vlab/uvc/test_picture.h"
@@ -573,7 +573,7 @@ TEST(LabUvc, UsbipCameraOnVhciStreams) {
 
 class LabHidReplay : public testing::TestWithParam<const char*> {};
 
-std::size_t totalReports(const std::vector<sim::vlab::HidRecordedDevice>& devices) {
+std::size_t totalReports(const std::vector<sim::HidRecordedDevice>& devices) {
   std::size_t n = 0;
   for (const auto& d : devices) n += d.reports.size();
   return n;
@@ -588,8 +588,9 @@ TEST_P(LabHidReplay, RecordingReplaysThroughHidraw) {
   const fs::path data = test::testdataDir();
   if (data.empty()) GTEST_SKIP() << "../shared/testdata is missing (BASALT_TESTDATA)";
   const fs::path file = data / "hid" / GetParam();
-  auto recording = sim::vlab::readHidRecording(file);
-  ASSERT_TRUE(recording) << recording.error().describe();
+  auto read = sim::readHidRecording(file);
+  ASSERT_TRUE(read) << read.error().describe();
+  const std::vector<sim::HidRecordedDevice>* recording = &read->devices;
   std::string tool = env("BASALT_VLAB_HID_REPLAY");
   if (tool.empty()) tool = (test::binaryDir() / "sim" / "vlab" / "basalt-vlab-hid-replay").string();
 
