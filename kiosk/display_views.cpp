@@ -59,7 +59,69 @@ Result<std::unique_ptr<DisplayViews>> DisplayViews::create(const std::vector<Vie
     }
     d->views_.push_back(std::move(v));
   }
+  // Aids views show a facet view's set-up: resolved once every facet view is loaded.
+  for (View& v : d->views_) {
+    if (v.spec.kind != ViewKind::kAids) continue;
+    const auto target = d->facetViewNamed(v.spec.of);
+    if (!target) {
+      return fail(Errc::kInvalidArgument,
+                  v.spec.of.empty() ? fmt::format("view '{}': the visual aids need a facet view to show", v.spec.name)
+                                    : fmt::format("view '{}': '{}' is not a facet view", v.spec.name, v.spec.of));
+    }
+    v.shows = *target;
+    auto aids = runtime::CaveAids::create(d->views_[*target].cave.geometry);
+    if (!aids) return std::unexpected(aids.error());
+    v.aids.emplace(std::move(*aids));
+  }
   return d;
+}
+
+std::optional<std::size_t> DisplayViews::facetViewNamed(const std::string& of) const {
+  for (std::size_t i = 0; i < views_.size(); ++i) {
+    if (views_[i].spec.kind == ViewKind::kFacet && (of.empty() || views_[i].spec.name == of)) return i;
+  }
+  return std::nullopt;
+}
+
+runtime::FacetViewInput DisplayViews::facetInput(const View& v, const runtime::Show& show) {
+  runtime::FacetViewInput input;
+  input.calibration = v.cave.settings;
+  input.worldFromCave = runtime::cavePlacement(show);
+  input.farDistance = show.viewer().farClip;
+  input.rearProjection = v.spec.rearProjection;
+  return input;
+}
+
+void DisplayViews::drawAids(View& v, const runtime::Show& show,
+                            const std::function<void(runtime::ViewTransforms&)>& adjust) {
+  const View& target = views_[v.shows];
+  const formats::CaveGeometry& g = *target.cave.geometry;
+  const std::uint32_t index = target.cave.settings.facet < g.facets.size() ? target.cave.settings.facet : 0;
+  runtime::FacetViewInput input = facetInput(target, show);
+  const render::Viewport& tvp = target.viewport;
+  input.aspect = static_cast<float>(std::max(tvp.width, 1U)) / static_cast<float>(std::max(tvp.height, 1U));
+  // The facet view's own projection, computed afresh so that the aids follow a calibration
+  // changed this frame whichever view is drawn first.
+  if (!runtime::computeFacetView(g.facets[index], input, v.last)) v.last.visible = false;
+  v.aids->update(index, v.last, input.viewer);
+
+  const render::Viewport& vp = v.viewport;
+  const float aspect = static_cast<float>(std::max(vp.width, 1U)) / static_cast<float>(std::max(vp.height, 1U));
+  const Vec3 from =
+      v.spec.from ? Vec3{(*v.spec.from)[0], (*v.spec.from)[1], (*v.spec.from)[2]} : runtime::CaveAids::kDefaultFrom;
+  runtime::ViewTransforms t = v.aids->outsideView(input.worldFromCave, from, aspect);
+  // The world as the facet views place it, then the aids over it (always in sight: a clear
+  // depth buffer, so the world never hides the display's outline).
+  t.model = show.position().global * show.position().local * runtime::viewNormalisation(show);
+  if (adjust) adjust(t);
+  render::ViewPass world;
+  world.viewport = vp;
+  renderer_.draw(show, t, world);
+  t.model = input.worldFromCave;
+  render::ViewPass overlay;
+  overlay.viewport = vp;
+  overlay.drawBackground = false;
+  renderer_.draw(v.aids->show(), t, overlay);
 }
 
 void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
@@ -85,10 +147,7 @@ void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
         const std::uint32_t index = v.cave.settings.facet < g.facets.size() ? v.cave.settings.facet : 0;
         render::FacetPass pass;
         pass.facet = &g.facets[index];
-        pass.input.calibration = v.cave.settings;
-        pass.input.worldFromCave = runtime::cavePlacement(show);
-        pass.input.farDistance = show.viewer().farClip;
-        pass.input.rearProjection = v.spec.rearProjection;
+        pass.input = facetInput(v, show);
         pass.viewport = vp;
         using S = ViewSpec::Stereo;
         switch (v.spec.stereo) {
@@ -110,6 +169,7 @@ void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
         v.last = facets_->lastProjection();
         break;
       }
+      case ViewKind::kAids: drawAids(v, show, adjust); break;
     }
   }
 }
@@ -140,6 +200,11 @@ Result<void> DisplayViews::saveCalibration(std::size_t index) const {
   }
   const View& v = views_[index];
   return formats::writeCave(v.cave.path, v.cave.settings);
+}
+
+const runtime::CaveAids* DisplayViews::aids(std::size_t index) const {
+  if (index >= views_.size() || !views_[index].aids) return nullptr;
+  return &*views_[index].aids;
 }
 
 const runtime::FacetProjection* DisplayViews::lastProjection(std::size_t index) const {

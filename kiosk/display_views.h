@@ -2,19 +2,23 @@
 
 /// \file
 /// \brief The views a show manifest asks for (`[[views]]`), drawn each frame: plain views, one
-/// stereo eye per view (a passive projector per eye), and facets of a polyhedral display
-/// (thesis §4.4) in mono or any stereo layout, tiled in one output or each filling an output.
+/// stereo eye per view (a passive projector per eye), facets of a polyhedral display (thesis
+/// §4.4) in mono or any stereo layout, tiled in one output or each filling an output, and the
+/// visual aids of a facet view (§4.4.6: the display seen from outside with the current facet,
+/// its normal, the viewer and the computed vectors, over the world).
 /// Holds each facet view's calibration, adjustable live with the thesis' keys (Appendix B) and
 /// saved back to its `.cave` file.
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "kiosk/manifest.h"
 #include "render/facet_view.h"
 #include "render/renderer.h"
+#include "runtime/cave_aids.h"
 #include "runtime/cave_keys.h"
 #include "runtime/formats/cave.h"
 
@@ -52,6 +56,8 @@ class DisplayViews final : public ViewDrawer {
   [[nodiscard]] Result<void> saveCalibration(std::size_t index) const;
   /// \brief The projection drawn last for view `index` (facet views).
   [[nodiscard]] const runtime::FacetProjection* lastProjection(std::size_t index) const;
+  /// \brief The visual aids drawn last by view `index` (aids views).
+  [[nodiscard]] const runtime::CaveAids* aids(std::size_t index) const;
   [[nodiscard]] std::size_t size() const { return views_.size(); }
 
  private:
@@ -62,7 +68,14 @@ class DisplayViews final : public ViewDrawer {
     runtime::FacetProjection last;
     float eyeSpacing = -1;  ///< facet views: < 0 follows the show
     bool warned = false;
+    std::size_t shows = 0;                  ///< aids views: the facet view whose set-up they show
+    std::optional<runtime::CaveAids> aids;  ///< aids views
   };
+  /// The facet view `of` names (the first facet view when empty), if any.
+  [[nodiscard]] std::optional<std::size_t> facetViewNamed(const std::string& of) const;
+  /// The facet input of facet view `v` this frame (no aspect: the caller sets it).
+  static runtime::FacetViewInput facetInput(const View& v, const runtime::Show& show);
+  void drawAids(View& v, const runtime::Show& show, const std::function<void(runtime::ViewTransforms&)>& adjust);
   DisplayViews(render::Renderer& renderer, std::unique_ptr<render::FacetRenderer> facets)
       : renderer_(renderer), facets_(std::move(facets)) {}
 

@@ -861,13 +861,17 @@ class Reader {
       }
       ViewSpec v;
       v.line = lineOf(*t);
-      checkKeys(*t, path, {"name", "kind", "cave", "facet", "eye", "viewport", "stereo", "eye_spacing", "projection"});
+      checkKeys(
+          *t, path,
+          {"name", "kind", "cave", "facet", "eye", "viewport", "stereo", "eye_spacing", "projection", "of", "from"});
       v.name = string(*t, "name", path).value_or(fmt::format("view {}", index));
       if (!names.insert(v.name).second)
         error(v.line, fmt::format("{}: a view named '{}' already exists", path, v.name));
-      if (auto kind = choice<ViewKind>(
-              *t, "kind", path,
-              {{"plain", ViewKind::kPlain}, {"facet", ViewKind::kFacet}, {"stereo", ViewKind::kStereo}})) {
+      if (auto kind = choice<ViewKind>(*t, "kind", path,
+                                       {{"plain", ViewKind::kPlain},
+                                        {"facet", ViewKind::kFacet},
+                                        {"stereo", ViewKind::kStereo},
+                                        {"aids", ViewKind::kAids}})) {
         v.kind = *kind;
       }
       if (const toml::node* cave = t->get("cave")) {
@@ -906,8 +910,45 @@ class Reader {
       if (v.kind != ViewKind::kStereo && t->get("eye")) {
         warning(v.line, fmt::format("{}: eye applies to stereo views only", path));
       }
+      if (auto of = string(*t, "of", path)) v.of = *of;
+      if (const toml::node* from = t->get("from")) readFrom(*from, path, v);
+      if (v.kind != ViewKind::kAids && (t->get("of") || t->get("from"))) {
+        warning(v.line, fmt::format("{}: of and from apply to aids views only", path));
+      }
       manifest_.views.push_back(std::move(v));
     }
+    // An aids view shows a facet view's set-up: the one it names, or the first.
+    for (const ViewSpec& v : manifest_.views) {
+      if (v.kind != ViewKind::kAids) continue;
+      const auto facetView = std::find_if(manifest_.views.begin(), manifest_.views.end(), [&](const ViewSpec& o) {
+        return o.kind == ViewKind::kFacet && (v.of.empty() || o.name == v.of);
+      });
+      if (facetView != manifest_.views.end()) continue;
+      if (v.of.empty()) {
+        error(v.line, fmt::format("views: the aids view '{}' needs a facet view to show; add one with kind = \"facet\"",
+                                  v.name));
+      } else {
+        error(v.line, fmt::format("views: the aids view '{}' names '{}', which is not a facet view", v.name, v.of));
+      }
+    }
+  }
+
+  void readFrom(const toml::node& node, const std::string& path, ViewSpec& v) {
+    const toml::array* a = node.as_array();
+    std::array<float, 3> values{};
+    bool ok = a && a->size() == 3;
+    for (std::size_t i = 0; ok && i < 3; ++i) {
+      const toml::node* element = a->get(i);
+      const auto n = element ? element->value<double>() : std::nullopt;
+      ok = n && std::isfinite(*n) && std::abs(*n) <= 1e6;
+      if (ok) values[i] = static_cast<float>(*n);
+    }
+    ok = ok && (values[0] != 0 || values[1] != 0 || values[2] != 0);
+    if (!ok) {
+      error(lineOf(node), fmt::format("{}.from: must be a direction [x, y, z] in the cave's axes, not all zero", path));
+      return;
+    }
+    v.from = values;
   }
 
   void readViewport(const toml::node& node, const std::string& path, ViewSpec& v) {

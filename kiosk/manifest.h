@@ -86,7 +86,9 @@ struct OutputSpec {
 };
 
 /// \brief How one view sees the show (DESIGN.md §3 "View").
-enum class ViewKind : std::uint8_t { kPlain, kFacet, kStereo };
+/// \brief What a view shows: the show plainly, one facet of a polyhedral display, one stereo
+/// eye, or the visual aids of a facet view (the display seen from outside, thesis §4.4.6).
+enum class ViewKind : std::uint8_t { kPlain, kFacet, kStereo, kAids };
 enum class Eye : std::uint8_t { kLeft, kRight };
 
 /// \brief `[[views]]`: where a picture goes and from where it is seen.
@@ -102,8 +104,10 @@ struct ViewSpec {
   bool facetGiven = false;  ///< facet: `facet` was given (else the cave file's facet[] is used)
   /// plain and facet: how the eyes are shown; "show" follows the show's stereo setting
   enum class Stereo : std::uint8_t { kShow, kOff, kAnaglyph, kSideBySide, kTopBottom } stereo = Stereo::kShow;
-  std::optional<float> eyeSpacing;  ///< facet: distance between the eyes in cave units (default: the show's)
-  bool rearProjection = true;       ///< facet: `projection = "rear"` (the thesis' default) or "front"
+  std::optional<float> eyeSpacing;           ///< facet: distance between the eyes in cave units (default: the show's)
+  bool rearProjection = true;                ///< facet: `projection = "rear"` (the thesis' default) or "front"
+  std::string of;                            ///< aids: the facet view whose set-up is shown ("" = the first facet view)
+  std::optional<std::array<float, 3>> from;  ///< aids: direction the display is seen from (cave axes)
 };
 
 /// \brief What a show entry, playlist item or standby item plays.

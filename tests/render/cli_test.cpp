@@ -68,8 +68,8 @@ TEST(Cli, DefaultSnapshotGoesToTheOutputFolder) {
   EXPECT_EQ(image->height, 200u);
 }
 
-/// True once the process blocks SIGTERM (its SigBlk mask in /proc), i.e. reads it as an event.
-bool sigtermBlocked(pid_t pid) {
+/// True once the process blocks `sig` (its SigBlk mask in /proc), i.e. reads it as an event.
+bool signalBlocked(pid_t pid, int sig) {
   std::FILE* f = std::fopen(("/proc/" + std::to_string(pid) + "/status").c_str(), "r");
   if (!f) return false;
   char line[256];
@@ -78,28 +78,67 @@ bool sigtermBlocked(pid_t pid) {
     if (std::sscanf(line, "SigBlk: %llx", &mask) == 1) break;
   }
   std::fclose(f);
-  return (mask >> (SIGTERM - 1) & 1ULL) != 0;
+  return (mask >> (sig - 1) & 1ULL) != 0;
 }
 
-TEST(Cli, StopsCleanlyOnSigterm) {
-  std::string why;
-  if (!eglAvailable(why)) GTEST_SKIP() << "no headless EGL here: " << why;
-  const auto dir = test::scratchDir("cli-sigterm");
+/// Runs `basalt run --headless` with no frame limit until `sig`, then checks it stopped cleanly
+/// and wrote the snapshot of its last frame.
+void stopsCleanlyOn(int sig, const char* name) {
+  const auto dir = test::scratchDir(std::string("cli-") + name);
   // No frame limit: runs paced on the system clock until the signal, then writes its snapshot
   // of the last frame and exits 0.
   test::Process p = test::Process::start(
       {(test::binaryDir() / "basalt").string(), "run", "--headless", "--snapshot", (dir / "last.png").string()});
   ASSERT_TRUE(p.started());
-  // Signal once basalt handles SIGTERM (blocked, read through its event loop): a fixed sleep
+  // Signal once basalt handles the signal (blocked, read through its event loop): a fixed sleep
   // lost the race on a loaded machine and the default action killed it mid-start.
-  for (int i = 0; i < 400 && !sigtermBlocked(p.pid()); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  for (int i = 0; i < 400 && !signalBlocked(p.pid(), sig); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  p.signal(SIGTERM);
+  p.signal(sig);
   const auto r = p.wait(std::chrono::seconds(20));
-  EXPECT_FALSE(r.timedOut) << "basalt did not stop on SIGTERM";
+  EXPECT_FALSE(r.timedOut) << "basalt did not stop on " << name;
   EXPECT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find("snapshot written"), std::string::npos) << r.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "last.png")) << r.output;
+}
+
+TEST(Cli, StopsCleanlyOnSigterm) {
+  std::string why;
+  if (!eglAvailable(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  stopsCleanlyOn(SIGTERM, "sigterm");
+}
+
+TEST(Cli, StopsCleanlyOnSigint) {
+  // Ctrl-C in the terminal that started it.
+  std::string why;
+  if (!eglAvailable(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  stopsCleanlyOn(SIGINT, "sigint");
+}
+
+TEST(Cli, RunsForSecondsAndWritesIntoOutByDefault) {
+  // `--seconds` ends the run after that much show time (headless runs play on a manual clock,
+  // as fast as the machine goes: 1.5 s at the default show's 60 frames per second is 90
+  // frames); with no output option the snapshot goes to out/ under the folder basalt was
+  // started in, as the README says.
+  // Example failure: --seconds read but ignored (a run that never ends); the snapshot written
+  // beside the binary instead of the user's folder.
+  std::string why;
+  if (!eglAvailable(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  const auto dir = test::scratchDir("cli-seconds");
+  std::filesystem::remove_all(dir / "out");
+  const auto r = test::run({"/bin/sh", "-c",
+                            "cd '" + dir.string() + "' && exec '" + (test::binaryDir() / "basalt").string() +
+                                "' run --headless --seconds 1.5 --size 160x120"},
+                           {}, std::chrono::seconds(60));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find(" 90 frames in "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("frames per second"), std::string::npos) << r.output;
+  auto image = media::readImage(dir / "out" / "snapshot.png");
+  ASSERT_TRUE(image) << image.error().describe() << "\n" << r.output;
+  EXPECT_EQ(image->width, 160u);
+  EXPECT_EQ(image->height, 120u);
 }
 
 TEST(Cli, UnwritableOutputFolderIsOneClearLine) {

@@ -169,3 +169,108 @@ TEST_F(DisplayViewsTest, TheCubeCaveExampleDrawsItsSixWalls) {
 
 }  // namespace
 }  // namespace basalt::test
+
+// The visual aids of thesis §4.4.6 as an aids view: the cube display seen from outside beside
+// its front facet view, with the current facet filled, its normal, the viewer's cone and the
+// vectors; a facet changed by calibration moves the filled facet. The manifest's aids keys.
+// Example failures: the aids hidden by the world drawn over them; the filled facet not following
+// the facet view's calibration; an aids view naming no facet view accepted.
+namespace basalt::test {
+namespace {
+
+/// Pixels of a colour family: the filled facet's yellow, the normal's magenta.
+std::size_t countPixels(const Image& image, std::uint32_t x0, std::uint32_t x1, bool (*match)(int r, int g, int b)) {
+  std::size_t n = 0;
+  for (std::uint32_t y = 0; y < image.height; ++y) {
+    for (std::uint32_t x = x0; x < x1; ++x)
+      n += match(image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)) ? 1U : 0U;
+  }
+  return n;
+}
+bool yellowish(int r, int g, int b) { return r > 150 && g > 120 && b < 90 && r - b > 100; }
+bool magenta(int r, int g, int b) { return r > 200 && g < 110 && b > 200; }
+
+TEST_F(DisplayViewsTest, VisualAidsShowTheDisplayFromOutside) {
+  kiosk::ViewSpec front;
+  front.name = "front";
+  front.kind = kiosk::ViewKind::kFacet;
+  front.cave = folder_ / "display.cave";  // facet[5]
+  front.viewport = std::array<std::uint32_t, 4>{0, 0, 128, 256};
+  kiosk::ViewSpec aids;
+  aids.name = "check";
+  aids.kind = kiosk::ViewKind::kAids;
+  aids.viewport = std::array<std::uint32_t, 4>{128, 0, 128, 256};
+  aids.from = std::array<float, 3>{1.5f, 0.7f, 0.4f};  // from the right: the cone and vectors side on
+  auto views = kiosk::DisplayViews::create({front, aids}, renderer(), output().size());
+  ASSERT_TRUE(views) << views.error().describe();
+  runtime::Show show = runtime::Show::makeDefault();
+  const Image image = draw(**views, show);
+  const std::string problem = matchesGolden(image, "views_cube_aids");
+  EXPECT_TRUE(problem.empty()) << problem;
+  ASSERT_NE((*views)->aids(1), nullptr);
+  EXPECT_EQ((*views)->aids(1)->currentFacet(), 5u);
+  EXPECT_EQ((*views)->aids(0), nullptr);
+  // The aids are in the right half only, and drawn over the world.
+  EXPECT_GT(countPixels(image, 128, 256, yellowish), 200u) << "no filled facet";
+  EXPECT_GT(countPixels(image, 128, 256, magenta), 5u) << "no facet normal";
+  EXPECT_EQ(countPixels(image, 0, 128, magenta), 0u);
+
+  // Another facet through the calibration: the filled facet moves with it.
+  (*views)->calibration(0)->facet = 0;
+  const Image other = draw(**views, show);
+  EXPECT_EQ((*views)->aids(1)->currentFacet(), 0u);
+  std::size_t moved = 0;
+  for (std::uint32_t y = 0; y < image.height; ++y) {
+    for (std::uint32_t x = 128; x < 256; ++x) {
+      const bool was = yellowish(image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2));
+      const bool is = yellowish(other.at(x, y, 0), other.at(x, y, 1), other.at(x, y, 2));
+      moved += was != is ? 1U : 0U;
+    }
+  }
+  EXPECT_GT(moved, 200u) << "the filled facet did not follow the calibration";
+}
+
+TEST_F(DisplayViewsTest, AnAidsViewNeedsAFacetView) {
+  kiosk::ViewSpec aids;
+  aids.name = "check";
+  aids.kind = kiosk::ViewKind::kAids;
+  auto views = kiosk::DisplayViews::create({aids}, renderer(), output().size());
+  ASSERT_FALSE(views);
+  EXPECT_NE(views.error().message().find("need a facet view"), std::string::npos) << views.error().describe();
+}
+
+TEST(DisplayViewsManifest, AidsViewKeysAreReadAndChecked) {
+  const std::filesystem::path folder = scratchDir("display_views_aids_manifest");
+  std::ofstream(folder / "display.obj") << cubeDisplayObj();
+  std::ofstream(folder / "display.cave") << "model display.obj\n";
+  const std::string facet =
+      "[show]\nname = \"cave\"\nentry = \"default\"\n[[views]]\nname = \"front\"\nkind = \"facet\"\ncave = "
+      "\"display.cave\"\n";
+  kiosk::Diagnostics diagnostics;
+  auto m = kiosk::readManifestText(facet +
+                                       "[[views]]\nname = \"check\"\nkind = \"aids\"\nof = \"front\"\n"
+                                       "from = [0, 1, 2.5]\n",
+                                   folder / "show.toml", diagnostics);
+  ASSERT_TRUE(m) << diagnostics.format();
+  ASSERT_EQ(m->views.size(), 2u);
+  EXPECT_EQ(m->views[1].kind, kiosk::ViewKind::kAids);
+  EXPECT_EQ(m->views[1].of, "front");
+  ASSERT_TRUE(m->views[1].from);
+  EXPECT_FLOAT_EQ((*m->views[1].from)[2], 2.5f);
+
+  kiosk::Diagnostics unknown;
+  EXPECT_FALSE(
+      kiosk::readManifestText(facet + "[[views]]\nkind = \"aids\"\nof = \"back\"\n", folder / "show.toml", unknown));
+  EXPECT_NE(unknown.format().find("names 'back', which is not a facet view"), std::string::npos) << unknown.format();
+  kiosk::Diagnostics none;
+  EXPECT_FALSE(kiosk::readManifestText("[show]\nname = \"x\"\nentry = \"default\"\n[[views]]\nkind = \"aids\"\n",
+                                       folder / "show.toml", none));
+  EXPECT_NE(none.format().find("needs a facet view to show"), std::string::npos) << none.format();
+  kiosk::Diagnostics zero;
+  EXPECT_FALSE(
+      kiosk::readManifestText(facet + "[[views]]\nkind = \"aids\"\nfrom = [0, 0, 0]\n", folder / "show.toml", zero));
+  EXPECT_NE(zero.format().find("from: must be a direction"), std::string::npos) << zero.format();
+}
+
+}  // namespace
+}  // namespace basalt::test

@@ -28,12 +28,26 @@ std::string read(const std::filesystem::path& p) {
 
 TEST(SystemdUnit, HasWhatAKioskServiceNeeds) {
   const std::string unit = read(test::sourceDir() / "configs/systemd/basalt.service");
-  for (const char* line :
-       {"Type=notify", "WatchdogSec=10", "Restart=always", "NoNewPrivileges=yes", "ProtectSystem=strict",
-        "ProtectHome=yes", "PrivateTmp=yes", "DevicePolicy=closed", "DeviceAllow=char-drm rw",
-        "DeviceAllow=char-video4linux rw", "DeviceAllow=char-media rw", "DeviceAllow=char-hidraw rw",
-        "DeviceAllow=char-ttyUSB rw", "DeviceAllow=char-usb_device rw", "StateDirectory=basalt",
-        "ExecReload=/bin/kill -HUP $MAINPID", "StartLimitIntervalSec=0", "CapabilityBoundingSet="}) {
+  for (const char* line : {"Type=notify",
+                           "WatchdogSec=10",
+                           "Restart=always",
+                           "NoNewPrivileges=yes",
+                           "ProtectSystem=strict",
+                           "ProtectHome=yes",
+                           "PrivateTmp=yes",
+                           "DevicePolicy=closed",
+                           "DeviceAllow=char-drm rw",
+                           "DeviceAllow=char-video4linux rw",
+                           "DeviceAllow=char-media rw",
+                           "DeviceAllow=char-hidraw rw",
+                           "DeviceAllow=char-ttyUSB rw",
+                           "DeviceAllow=char-usb_device rw",
+                           "StateDirectory=basalt",
+                           "ExecReload=/bin/kill -HUP $MAINPID",
+                           "StartLimitIntervalSec=0",
+                           "CapabilityBoundingSet=",
+                           "SupplementaryGroups=video render input dialout",
+                           "DeviceAllow=char-ttyS rw"}) {
     EXPECT_NE(unit.find(std::string("\n") + line + "\n"), std::string::npos) << line;
   }
   EXPECT_EQ(unit.find("MemoryDenyWriteExecute=yes"), std::string::npos)
@@ -79,8 +93,10 @@ TEST(UdevRule, EveryLineParsesAndTheSupportedDevicesAreCovered) {
     ++rulesSeen;
   }
   EXPECT_GE(rulesSeen, 8);
-  for (const char* device : {"ATTR{idVendor}==\"077d\", ATTR{idProduct}==\"0410\"", "0003:256C:0060", "0005:256C:8251",
-                             "0005:045E:091B", "0003:0B33:0020", "SUBSYSTEM==\"video4linux\""}) {
+  for (const char* device :
+       {"ATTR{idVendor}==\"077d\", ATTR{idProduct}==\"0410\"", "0003:256C:0060", "0005:256C:8251", "0005:045E:091B",
+        "0003:0B33:0020", "SUBSYSTEM==\"video4linux\"",
+        "SUBSYSTEM==\"tty\", KERNEL==\"ttyS[0-9]*|ttyUSB[0-9]*|ttyACM[0-9]*\", GROUP=\"dialout\""}) {
     EXPECT_NE(rules.find(device), std::string::npos) << device;
   }
   EXPECT_NE(rules.find("LABEL=\"basalt_end\""), std::string::npos) << "the GOTO's label";
