@@ -1,5 +1,6 @@
 #include "kiosk/display_views.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -192,6 +193,48 @@ bool DisplayViews::applyKey(const Event& event) {
 formats::CaveSettings* DisplayViews::calibration(std::size_t index) {
   if (index >= views_.size() || views_[index].spec.kind != ViewKind::kFacet) return nullptr;
   return &views_[index].cave.settings;
+}
+
+Result<std::string> DisplayViews::calibrate(std::string_view name, std::string_view statements, bool save) {
+  const auto index = facetViewNamed(std::string(name));
+  if (!index) {
+    std::string names;
+    for (const View& v : views_) {
+      if (v.spec.kind == ViewKind::kFacet) names += (names.empty() ? "'" : ", '") + v.spec.name + "'";
+    }
+    if (names.empty()) return fail(Errc::kNotFound, "this show has no facet views to calibrate");
+    return fail(Errc::kNotFound, fmt::format("no facet view '{}'; the facet views are {}", name, names));
+  }
+  View& v = views_[*index];
+  std::string text(statements);
+  std::replace(text.begin(), text.end(), ';', '\n');
+  auto parsed =
+      formats::parseCaveText(text, fmt::format("calibration of view '{}'", v.spec.name), v.cave.settings, true);
+  if (!parsed) return std::unexpected(parsed.error());
+  if (parsed->modelGiven) {
+    return fail(Errc::kInvalidArgument,
+                "the display geometry cannot change while the show plays: edit the cave file and reload");
+  }
+  const formats::CaveGeometry& g = *v.cave.geometry;
+  const formats::CaveSettings& next = parsed->settings;
+  if (next.facet >= g.facets.size()) {
+    return fail(Errc::kInvalidArgument, fmt::format("facet {} does not exist; the display has facets 0 to {}",
+                                                    next.facet, g.facets.size() - 1));
+  }
+  if (next.side >= g.facets[next.facet].corners.size()) {
+    return fail(Errc::kInvalidArgument, fmt::format("side {} does not exist; facet {} has sides 0 to {}", next.side,
+                                                    next.facet, g.facets[next.facet].corners.size() - 1));
+  }
+  v.cave.settings = next;
+  log::info(kLogViews, "view '{}' calibrated: {}", v.spec.name, statements);
+  if (save) {
+    if (auto written = saveCalibration(*index); !written) return std::unexpected(written.error());
+    log::info(kLogViews, "view '{}': calibration saved to {}", v.spec.name, v.cave.path.string());
+  }
+  const formats::CaveSettings& c = v.cave.settings;
+  return fmt::format("view '{}': facet[{}] side[{}] Xscale[{}] Yscale[{}] Xskew[{}] Yskew[{}] Zrotation[{}]{}",
+                     v.spec.name, c.facet, c.side, c.xScale, c.yScale, c.xSkew, c.ySkew, c.zRotation,
+                     save ? fmt::format(" (saved to {})", v.cave.path.string()) : std::string());
 }
 
 Result<void> DisplayViews::saveCalibration(std::size_t index) const {

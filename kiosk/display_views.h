@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "kiosk/manifest.h"
@@ -52,6 +53,13 @@ class DisplayViews final : public ViewDrawer {
   bool selectView(std::size_t index);
   /// \brief The calibration of view `index` (a facet view), to read or change live.
   [[nodiscard]] formats::CaveSettings* calibration(std::size_t index);
+  /// \brief Calibration as text, for the control server: `statements` in the cave file's syntax
+  /// (`facet`, `side`, `Xscale`, `Yscale`, `Xskew`, `Yskew`, `Zrotation`; no `model`), one per
+  /// line or separated by ';', applied to the facet view named `name` ("" = the first) as one
+  /// change: a bad statement changes nothing. With `save`, written back to its cave file.
+  /// Returns the view's settings afterwards, in the cave file's bracket form on one line. Errors: kNotFound (no such
+  /// facet view), kInvalidArgument or kParse (a bad statement), kIo (the file could not be written).
+  [[nodiscard]] Result<std::string> calibrate(std::string_view name, std::string_view statements, bool save);
   /// \brief Writes view `index`'s calibration back to its cave file.
   [[nodiscard]] Result<void> saveCalibration(std::size_t index) const;
   /// \brief The projection drawn last for view `index` (facet views).

@@ -568,6 +568,7 @@ int runShow(const RunOptions& options) {
     if (!made) return failWith(made.error(), "cannot set up the show's views");
     views = std::move(*made);
     frameLoop.setViewDrawer(views.get());
+    director.setViews(views.get());
   }
 
   FrameMetrics metrics(board, &events, (*output)->describe());

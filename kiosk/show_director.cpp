@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "kiosk/display_views.h"
 #include "runtime/log.h"
 
 namespace basalt::kiosk {
@@ -253,6 +254,20 @@ void ShowDirector::handleControls(const FrameContext& frame) {
                        opened ? fmt::format("'{}' restarted", request.argument)
                               : fmt::format("'{}' could not be reopened: {}; it is retried every few seconds",
                                             request.argument, opened.error().describe()));
+        }
+        break;
+      }
+      case ControlKind::kCalibrate: {
+        if (!views_) {
+          reply.answer(409, "this show has no facet views to calibrate (add [[views]] with kind = \"facet\")");
+          break;
+        }
+        auto out = views_->calibrate(request.view, request.argument, request.save);
+        if (out) {
+          reply.answer(200, *out);
+        } else {
+          const Errc code = out.error().code();
+          reply.answer(code == Errc::kNotFound ? 404 : code == Errc::kIo ? 500 : 400, out.error().describe());
         }
         break;
       }

@@ -31,6 +31,8 @@
 namespace basalt::kiosk {
 
 /// \brief What the director works with; everything is borrowed and outlives it.
+class DisplayViews;
+
 struct DirectorContext {
   const Clock& clock;
   runtime::EventLoop& loop;
@@ -60,6 +62,9 @@ class ShowDirector final : public FrameParticipant {
   /// \brief Re-reads the manifest on a loader thread; the current show plays on until the new
   /// one is ready, and stays when the new one has errors.
   void requestReload();
+  /// \brief The show's views, for the calibration control (null: no `[[views]]`). Borrowed:
+  /// they must outlive the director's frames.
+  void setViews(DisplayViews* views) { views_ = views; }
 
   Result<void> beforeDraw(const FrameContext& frame) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
@@ -92,6 +97,7 @@ class ShowDirector final : public FrameParticipant {
   void releaseItemTextures(const std::string& nextKey);
 
   DirectorContext context_;
+  DisplayViews* views_ = nullptr;
   std::unique_ptr<LoadedShow> show_;
   std::unique_ptr<KioskPolicy> policy_;
   std::shared_ptr<const Schedule> scheduleForStatus_;

@@ -97,7 +97,7 @@ struct StatusSnapshot {
 };
 
 /// \brief A request from the control server to the frame loop, answered through `reply`.
-enum class ControlKind : std::uint8_t { kNext, kPrevious, kReload, kRunCommand, kRestartDevice };
+enum class ControlKind : std::uint8_t { kNext, kPrevious, kReload, kRunCommand, kRestartDevice, kCalibrate };
 
 struct ControlReply {
   std::mutex mutex;
@@ -113,7 +113,9 @@ struct ControlReply {
 
 struct ControlRequest {
   ControlKind kind = ControlKind::kNext;
-  std::string argument;  ///< the command, or the device's name
+  std::string argument;  ///< the command, the device's name, or calibration statements
+  std::string view;      ///< kCalibrate: the facet view ("" = the first)
+  bool save = false;     ///< kCalibrate: write the calibration back to the cave file
   std::shared_ptr<ControlReply> reply;
 };
 

@@ -7,6 +7,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
 #include <fstream>
 #include <map>
@@ -255,6 +256,10 @@ void StatusServer::routes() {
       ControlRequest request;
       request.kind = kind;
       request.argument = req.has_param("device") ? req.get_param_value("device") : trim(req.body);
+      request.view = req.has_param("view") ? req.get_param_value("view") : std::string();
+      request.save = req.has_param("save") && req.get_param_value("save") != "0";
+      // Calibration statements may come one per line, as in a cave file.
+      if (kind == ControlKind::kCalibrate) std::replace(request.argument.begin(), request.argument.end(), '\n', ';');
       if (needsArgument && request.argument.empty()) {
         replyJson(res, 400, false,
                   kind == ControlKind::kRunCommand ? "the body must be one LAVA script command"
@@ -286,6 +291,7 @@ void StatusServer::routes() {
   http.Post("/control/reload", control(ControlKind::kReload, false));
   http.Post("/control/command", control(ControlKind::kRunCommand, true));
   http.Post("/control/restart-device", control(ControlKind::kRestartDevice, true));
+  http.Post("/control/calibrate", control(ControlKind::kCalibrate, false));
 
   // Wrong methods on known paths say which method they take.
   const auto methodNotAllowed = [](std::string_view allowed) {
@@ -299,8 +305,8 @@ void StatusServer::routes() {
     http.Put(path, methodNotAllowed("GET"));
     http.Delete(path, methodNotAllowed("GET"));
   }
-  for (const char* path :
-       {"/control/next", "/control/previous", "/control/reload", "/control/command", "/control/restart-device"}) {
+  for (const char* path : {"/control/next", "/control/previous", "/control/reload", "/control/command",
+                           "/control/restart-device", "/control/calibrate"}) {
     http.Get(path, methodNotAllowed("POST"));
   }
 }

@@ -37,6 +37,24 @@ def skip_reason(output):
     return m.group(1).strip() if m else "(no reason given)"
 
 
+def failure_excerpt(out, limit=12):
+    """The lines of a test's output that say why it failed: GoogleTest's 'Failure' blocks, a
+    crash or a time-out, else its last lines."""
+    lines = [l.rstrip()[:300] for l in out.splitlines() if l.strip()]
+    keys = ("Failure", "Expected", "Value of", "Actual", "Which is", "Segmentation", "Timeout", "Aborted",
+            "Exception", "ERROR:", "AddressSanitizer", "runtime error")
+    chosen = []
+    for i, line in enumerate(lines):
+        if any(k in line for k in keys):
+            for j in (i, i + 1):
+                if j < len(lines) and j not in chosen and not lines[j].startswith("["):
+                    chosen.append(j)
+        if len(chosen) >= limit:
+            break
+    picked = [lines[j] for j in chosen]
+    return picked[:limit] if picked else lines[-limit:]
+
+
 def main():
     build = sys.argv[1] if len(sys.argv) > 1 else "build"
     try:
@@ -48,6 +66,7 @@ def main():
     per_label = collections.defaultdict(lambda: collections.Counter())
     skipped = collections.defaultdict(list)
     failed = []
+    excerpts = {}
     for case in suite.iter("testcase"):
         name = case.get("name")
         status = case.get("status")
@@ -58,6 +77,7 @@ def main():
         elif case.find("failure") is not None or status == "fail":
             kind = "failed"
             failed.append(name)
+            excerpts[name] = failure_excerpt(out)
         else:
             kind = "passed"
         for label in labels.get(name, ["(no label)"]):
@@ -78,6 +98,12 @@ def main():
         print("\nFailed:")
         for name in failed:
             print(f"  - {name}")
+        # Why, in a few lines each, so that the end of a CI log says what went wrong.
+        print("\nWhy each failed (the first lines of its failure; the whole output is above):")
+        for name in failed:
+            print(f"  - {name}:")
+            for line in excerpts[name]:
+                print(f"      {line}")
     skip_count = sum(len(names) for names in skipped.values())
     case_count = sum(1 for _ in suite.iter("testcase"))
     print(f"\n{'FAILED' if failed else 'OK'}: {len(failed)} failed, {skip_count} skipped, of {case_count} tests")

@@ -17,6 +17,8 @@
 
 #include "kiosk_process.h"
 #include "media/image_io.h"
+#include "runtime/formats/cave.h"
+#include "support/polyhedra.h"
 #include "support/test_paths.h"
 
 namespace basalt {
@@ -272,6 +274,82 @@ TEST(StatusServerWithoutToken, ControlsAreOff) {
   EXPECT_EQ(r.status, 403);
   EXPECT_NE(r.body.find("controls are off"), std::string::npos) << r.body;
   EXPECT_EQ(show->get("/health").status, 200) << "reading needs no token";
+}
+
+// ---- Calibrating a facet view -----------------------------------------------------------------
+
+// Makes sure a facet view's calibration can be changed and saved over HTTP (issue 10: calibration
+// "adjustable live ... and the control server"). Example failures: a calibration applied without
+// a token; a bad statement half applied; a saved cave file the loader then rejects.
+TEST(StatusServerCalibration, FacetViewsAreCalibratedAndSaved) {
+  std::string why;
+  if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  const auto dir = test::writeShow("status-calibrate", R"(
+[show]
+name = "Calibration test"
+entry = "default"
+fps = 30
+
+[output]
+kind = "headless"
+size = "160x120"
+
+[[views]]
+name = "front"
+kind = "facet"
+cave = "display.cave"
+
+[[views]]
+name = "left"
+kind = "facet"
+cave = "display.cave"
+facet = 0
+
+[status]
+listen = "127.0.0.1:0"
+token_file = "token"
+)");
+  std::ofstream(dir / "token") << kToken << "\n";
+  std::ofstream(dir / "display.obj") << test::cubeDisplayObj();
+  std::ofstream(dir / "display.cave") << "model display.obj\nfacet[5]\n";
+  auto show = test::RunningShow::start({(dir / "show.toml").string(), "--realtime", "--no-resume"}, {}, why);
+  ASSERT_TRUE(show) << why;
+  const std::string bearer = std::string("Bearer ") + kToken;
+
+  EXPECT_EQ(show->post("/control/calibrate", "Xscale[1.2]").status, 401);
+  const auto read = show->post("/control/calibrate", "", bearer);
+  EXPECT_EQ(read.status, 200) << read.body;
+  EXPECT_NE(read.body.find("view 'front': facet[5] side[0] Xscale[1] "), std::string::npos) << read.body;
+
+  const auto changed = show->post("/control/calibrate?view=left", "Xscale[1.25]\nYskew[-2]; side[1]", bearer);
+  EXPECT_EQ(changed.status, 200) << changed.body;
+  EXPECT_NE(changed.body.find("view 'left': facet[0] side[1] Xscale[1.25] Yscale[1] Xskew[0] Yskew[-2]"),
+            std::string::npos)
+      << changed.body;
+  // A bad statement changes nothing, and says what is wrong.
+  const auto bad = show->post("/control/calibrate?view=left", "Xscale[1.5]; Yscale[0]", bearer);
+  EXPECT_EQ(bad.status, 400) << bad.body;
+  EXPECT_NE(bad.body.find("Yscale must be more than 0"), std::string::npos) << bad.body;
+  EXPECT_EQ(show->post("/control/calibrate?view=left", "side[4]", bearer).status, 400);
+  EXPECT_EQ(show->post("/control/calibrate?view=left", "model other.obj", bearer).status, 400);
+  const auto unknown = show->post("/control/calibrate?view=back", "Xscale[1]", bearer);
+  EXPECT_EQ(unknown.status, 404) << unknown.body;
+  EXPECT_NE(unknown.body.find("the facet views are 'front', 'left'"), std::string::npos) << unknown.body;
+  EXPECT_EQ(show->get("/control/calibrate").status, 405);
+
+  // Saved: the cave file reads back with the new values (Xscale[1.5] was refused above).
+  const auto saved = show->post("/control/calibrate?view=left&save=1", "Xskew[3]", bearer);
+  EXPECT_EQ(saved.status, 200) << saved.body;
+  EXPECT_NE(saved.body.find("saved to"), std::string::npos) << saved.body;
+  auto cave = formats::loadCave(dir / "display.cave");
+  ASSERT_TRUE(cave) << cave.error().describe();
+  EXPECT_EQ(cave->settings.facet, 0u);
+  EXPECT_EQ(cave->settings.side, 1u);
+  EXPECT_FLOAT_EQ(cave->settings.xScale, 1.25f);
+  EXPECT_FLOAT_EQ(cave->settings.xSkew, 3.0f);
+  EXPECT_FLOAT_EQ(cave->settings.ySkew, -2.0f);
+  EXPECT_EQ(cave->settings.model, "display.obj");
+  EXPECT_EQ(::kill(show->process().pid(), 0), 0) << "the show still runs";
 }
 
 // ---- The page in a browser -----------------------------------------------------------------
