@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "render_fixture.h"
 
@@ -366,6 +367,43 @@ TEST_F(Goldens, ModelClipping) {
   EXPECT_GT(d.pixelsOverTolerance, 5000u);
 }
 
+TEST_F(Goldens, SixteenClippingPlanesEachCut) {
+  // LAVA's maximum of 16 model clipping planes, all at once: a square cut by 16 planes around its
+  // centre (each keeps the side towards the centre), so that what is left is a 16-sided polygon.
+  // Just inside each plane the square is drawn, just outside it is not; with 15 planes the last
+  // one's cut is back. Example failure: planes past the eighth ignored by the shader's loop.
+  Show show = showOf(makeQuad(0.9f, 0.0f, 1, "square"));
+  show.global().background = {0, 0, 0};
+  show.editGlobalStyle([](PartStyle& s) {
+    s.front.illumination = runtime::Illumination::kNone;
+    s.front.color = {1, 1, 1};
+  });
+  constexpr float kRadius = 0.6f;
+  auto direction = [](int k) {
+    const float a = 2.0f * std::numbers::pi_v<float> * static_cast<float>(k) / 16.0f;
+    return Vec3{std::cos(a), std::sin(a), 0};
+  };
+  show.modelClipping().numPlanes = 16;
+  for (int k = 0; k < 16; ++k) {
+    show.modelClipping().planes[static_cast<std::size_t>(k)] = {direction(k) * kRadius, -direction(k)};
+  }
+  const runtime::ViewTransforms view = testCamera();
+  auto drawn = [&](const Image& image, const Vec3& p) {
+    const Vec2 px = worldToPixel(view, p);
+    return image.at(static_cast<std::uint32_t>(px.x), static_cast<std::uint32_t>(px.y), 0) > 128;
+  };
+  const Image all = render(show, view);
+  for (int k = 0; k < 16; ++k) {
+    EXPECT_TRUE(drawn(all, direction(k) * (kRadius - 0.06f))) << "inside plane " << k;
+    EXPECT_FALSE(drawn(all, direction(k) * (kRadius + 0.025f))) << "outside plane " << k;
+  }
+  show.modelClipping().numPlanes = 15;
+  const Image fifteen = render(show, view);
+  // Just past plane 15 and inside its neighbours (22.5 degrees away: 0.625 cos 22.5 < 0.6).
+  EXPECT_TRUE(drawn(fifteen, direction(15) * (kRadius + 0.025f))) << "plane 15 still cuts with 15 planes on";
+  EXPECT_FALSE(drawn(fifteen, direction(14) * (kRadius + 0.025f)));
+}
+
 TEST_F(Goldens, IlluminationTypes) {
   // One sphere three times: per facet, per vertex, per pixel, under LAVA's default lights.
   Show show;
@@ -417,6 +455,35 @@ TEST_F(Goldens, FloorAndShadow) {
   show.environment().floor = runtime::FloorKind::kCoarseGrid;
   show.environment().floorPrimType = runtime::FloorPrimType::kWireframe;
   expectGolden(renderShow(show), "floor_wireframe");
+}
+
+TEST_F(Goldens, SingleSquareFloorCoversItsSquare) {
+  // LAVA's "single square" floor: one solid square under the object. Its corners' surroundings
+  // and its front edge show the floor where the plain show shows the background.
+  // Example failure: the single square drawn as a grid, or not at all.
+  Show show = Show::makeDefault();
+  show.view().objectScale = runtime::ObjectScale::kHalfScreen;
+  show.environment().floor = runtime::FloorKind::kNone;
+  const Image bare = renderShow(show);
+  show.environment().floor = runtime::FloorKind::kSingleSquare;
+  show.environment().floorColor = {0.2f, 0.8f, 0.3f};
+  const Image floor = renderShow(show);
+  const runtime::FloorGeometry geometry = runtime::computeFloor(show);
+  const runtime::ViewTransforms view = runtime::computeView(show, 1.0f);
+  int covered = 0;
+  for (const Vec3& p :
+       {Vec3{-0.4f, 0, 0.6f}, Vec3{0.4f, 0, 0.6f}, Vec3{0, 0, 0.7f}, Vec3{-0.6f, 0, 0.35f}, Vec3{0.6f, 0, 0.35f}}) {
+    const Vec2 px = worldToPixel(view, geometry.floor.transformPoint(p));
+    const auto x = static_cast<std::uint32_t>(px.x), y = static_cast<std::uint32_t>(px.y);
+    ASSERT_LT(x, kRenderSize);
+    ASSERT_LT(y, kRenderSize);
+    EXPECT_EQ(bare.at(x, y, 1), 0) << "background at " << x << "," << y;
+    // Lit by LAVA's default lights, the floor keeps its hue: green above red and blue.
+    EXPECT_GT(floor.at(x, y, 1), floor.at(x, y, 0)) << "floor at " << x << "," << y;
+    EXPECT_GT(floor.at(x, y, 1), floor.at(x, y, 2)) << "floor at " << x << "," << y;
+    covered += floor.at(x, y, 1) > 20 ? 1 : 0;
+  }
+  EXPECT_EQ(covered, 5);
 }
 
 }  // namespace
