@@ -938,6 +938,8 @@ Renderer::Renderer() = default;
 
 Renderer::~Renderer() = default;
 
+std::size_t Renderer::gpuMeshCount() const { return impl_->meshes.size(); }
+
 Result<std::unique_ptr<Renderer>> Renderer::create(const RendererOptions& options) {
   std::unique_ptr<Renderer> r(new Renderer);
   bool fetch = false;

@@ -105,6 +105,9 @@ class Renderer {
   /// \brief Counts summed over every draw since the last call (one frame, all its views), for
   /// the performance meter.
   runtime::FrameCounts takeFrameCounts();
+  /// \brief How many meshes have GPU buffers now: one per distinct Mesh drawn lately, however
+  /// many nodes instance it (what the instancing tests and the status figures read).
+  [[nodiscard]] std::size_t gpuMeshCount() const;
   /// \brief The textures parts can name (image files and streams).
   TextureRegistry& textures() { return textures_; }
   [[nodiscard]] const RendererCapabilities& capabilities() const { return caps_; }

@@ -488,3 +488,38 @@ TEST_F(Goldens, SingleSquareFloorCoversItsSquare) {
 
 }  // namespace
 }  // namespace basalt::test
+
+// Instancing on the GPU (Extended OBJ `instanceof`, issue 4): however many nodes share one Mesh,
+// the renderer keeps one set of GPU buffers for it, and draws every instance.
+// Example failure: a GPU copy per node (memory growing with the instance count).
+namespace basalt::test {
+namespace {
+
+TEST_F(Goldens, InstancesShareOneGpuMesh) {
+  auto fresh = render::Renderer::create();  // its own mesh cache, untouched by other tests
+  ASSERT_TRUE(fresh) << fresh.error().describe();
+  const std::shared_ptr<const runtime::Mesh> ball = makeSphere(0.2f, 8, 12, "ball");
+  Show show;
+  for (int i = 0; i < 25; ++i) {
+    runtime::SceneNode node;
+    node.name = fmt::format("ball {}", i);
+    node.mesh = ball;
+    node.local =
+        Mat4::translation({-0.8f + 0.4f * static_cast<float>(i % 5), -0.8f + 0.4f * static_cast<float>(i / 5), 0});
+    show.addNode(std::move(node));
+  }
+  ASSERT_TRUE(output().beginFrame());
+  (*fresh)->draw(show, testCamera(), output().size());
+  EXPECT_EQ((*fresh)->gpuMeshCount(), 1u) << "25 instances, one mesh";
+  EXPECT_EQ((*fresh)->lastCounts().triangles, 25u * ball->triangleCount()) << "every instance drawn";
+  // A second mesh is a second set of buffers.
+  runtime::SceneNode other;
+  other.name = "other";
+  other.mesh = makeSphere(0.2f, 8, 12, "ball");
+  show.addNode(std::move(other));
+  (*fresh)->draw(show, testCamera(), output().size());
+  EXPECT_EQ((*fresh)->gpuMeshCount(), 2u);
+}
+
+}  // namespace
+}  // namespace basalt::test
