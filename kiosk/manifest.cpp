@@ -1384,7 +1384,12 @@ class Reader {
                                                    {"scale", runtime::Action::kScale},
                                                    {"translate_x", runtime::Action::kTranslateX},
                                                    {"translate_y", runtime::Action::kTranslateY},
-                                                   {"translate_z", runtime::Action::kTranslateZ}})) {
+                                                   {"translate_z", runtime::Action::kTranslateZ},
+                                                   {"walk", runtime::Action::kWalk},
+                                                   {"strafe", runtime::Action::kStrafe},
+                                                   {"rise", runtime::Action::kRise},
+                                                   {"turn", runtime::Action::kTurn},
+                                                   {"tilt", runtime::Action::kTilt}})) {
           b.action = *action;
           b.gain = defaultGain(*action);
         }
@@ -1431,6 +1436,12 @@ class Reader {
       case runtime::Action::kTranslateX:
       case runtime::Action::kTranslateY:
       case runtime::Action::kTranslateZ: return 1;
+      // The walk-through viewer: a turn of the dial walks 2 scene units or turns a quarter.
+      case runtime::Action::kWalk:
+      case runtime::Action::kStrafe:
+      case runtime::Action::kRise: return 2;
+      case runtime::Action::kTurn:
+      case runtime::Action::kTilt: return 90;
       case runtime::Action::kNone:
       case runtime::Action::kMoveZoomX:  // the Zoom dials are `basalt run --zoom-dials`, not manifests
       case runtime::Action::kMoveZoomY: return 0;

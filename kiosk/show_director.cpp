@@ -1,6 +1,8 @@
 #include "kiosk/show_director.h"
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 
 #include <fmt/format.h>
 #include <fmt/std.h>
@@ -349,6 +351,32 @@ void ShowDirector::applyInput(Nanos until) {
                              });
 }
 
+void ShowDirector::applyOutputInput(Nanos now) {
+  std::array<Event, 64> input;
+  while (const std::size_t n = context_.output.takeInput(input)) {
+    for (std::size_t i = 0; i < n; ++i) {
+      Event& e = input[i];
+      e.time = now;
+      // A visitor at the keyboard or mouse counts as activity (a press or a move, not a release).
+      if ((e.kind == EventKind::kPointerMotion || e.value > 0.5) && policy_->noteInput(now)) applyProgramme(now);
+      if (e.kind == EventKind::kKey && views_ && views_->applyKey(e)) continue;
+      if (e.kind == EventKind::kPointerButton) {
+        pointerHeld_ = e.value > 0.5;
+        continue;
+      }
+      // The pointer turns the viewer while a button is held (dragging), so that a pointer merely
+      // crossing the window leaves the view alone.
+      if (e.kind == EventKind::kPointerMotion && !pointerHeld_) continue;
+      navigator_.apply(e, context_.show);
+    }
+    if (n < input.size()) break;
+  }
+  if (lastNavigate_.count() >= 0 && now > lastNavigate_) {
+    navigator_.advance(std::chrono::duration<double>(now - lastNavigate_).count(), context_.show);
+  }
+  lastNavigate_ = now;
+}
+
 void ShowDirector::advanceShuttles(Nanos now) {
   // Shuttle rings held off-centre turn the show by the show time since the last frame.
   if (player_ && lastAdvance_.count() >= 0 && now > lastAdvance_) {
@@ -442,6 +470,7 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
   const Nanos now = frame.time;
   serviceDevices(now);
   applyInput(now);
+  applyOutputInput(now);
   advanceShuttles(now);
   if (policy_->update(now, context_.clock.wallNow())) applyProgramme(now);
   if (player_) {

@@ -26,6 +26,7 @@
 #include "runtime/bounded_queue.h"
 #include "runtime/event.h"
 #include "runtime/event_loop.h"
+#include "runtime/navigation.h"
 #include "runtime/show/show.h"
 
 namespace basalt::kiosk {
@@ -86,6 +87,10 @@ class ShowDirector final : public FrameParticipant {
   void handleControls(const FrameContext& frame);
   void serviceDevices(Nanos now);
   void applyInput(Nanos until);
+  /// Keys and pointer from the output: activity for the kiosk, the facet views' calibration
+  /// keys (thesis Appendix B), then walking the viewer (Navigator): held keys move it per frame,
+  /// dragging with a button held turns it.
+  void applyOutputInput(Nanos now);
   void advanceShuttles(Nanos now);
   void applyProgramme(Nanos now);
   void updateStreams(Nanos now);
@@ -108,6 +113,10 @@ class ShowDirector final : public FrameParticipant {
   std::set<std::string> reportedFailures_;
   Nanos lastSave_{0};
   Nanos lastAdvance_{-1};  // the show time shuttle rings last turned the show to
+  // Keyboard and pointer of the output's window: calibration keys first, then navigation.
+  runtime::Navigator navigator_;
+  Nanos lastNavigate_{-1};    // the show time the navigator last moved the viewer to
+  bool pointerHeld_ = false;  // a pointer button is down: motion turns the viewer
 
   // Reload hand-over: the loader thread writes, the frame loop reads.
   std::mutex reloadMutex_;

@@ -7,10 +7,12 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
 #include "runtime/error.h"
+#include "runtime/event.h"
 #include "runtime/image.h"
 
 namespace basalt::render {
@@ -55,7 +57,21 @@ class Output {
   [[nodiscard]] virtual Result<void> setDisplayPower(bool on);
   /// \brief True once the person at a window closed it (window output only).
   [[nodiscard]] virtual bool closeRequested() const { return false; }
+  /// \brief Moves the keyboard and pointer input the output received since the last call into
+  /// `into` (as many as fit; call again for the rest) and returns how many: `kKey` with the
+  /// Linux key code, `kPointerMotion` in pixels, `kPointerButton`. Their `time` is left 0 for the
+  /// caller to stamp on the show's clock; `device` is kOutputInputDevice. Outputs without
+  /// input (headless, KMS: keyboards there are input devices of their own) give none.
+  virtual std::size_t takeInput(std::span<Event> into) {
+    (void)into;
+    return 0;
+  }
+  /// \brief The events dropped because nobody took them in time (the buffer holds 256).
+  [[nodiscard]] virtual std::uint64_t inputDropped() const { return 0; }
 };
+
+/// \brief The device id of the input an output's window receives (keyboard and pointer).
+inline constexpr DeviceId kOutputInputDevice = 0xFFFF'FF00U;
 
 /// \brief Renders into an offscreen framebuffer on EGL's surfaceless platform (Mesa): no
 /// display, no DRM master, no window system. What tests, CI, recording and headless nodes use.

@@ -3,7 +3,9 @@
 // Hardware: any X server (Xorg, XWayland, Xvfb in tests) with an EGL driver for it (Mesa).
 // Limits: X11 only; Wayland desktops run it through XWayland. The window can be resized (the
 // output's size follows) and closed (closeRequested() turns true and `basalt run` stops).
-// Presentation is not synchronised to vertical blank: the frame loop paces itself.
+// Presentation is not synchronised to vertical blank: the frame loop paces itself. Keys, pointer
+// motion and buttons in the window become input events (takeInput) for the show's calibration
+// and navigation keys.
 // Configuration: $DISPLAY; the manifest's [output] size and fullscreen.
 
 #include "render/window_output.h"
@@ -12,6 +14,8 @@
 #include <X11/Xlib.h>
 #include <X11/Xutil.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdlib>
 
 #include <fmt/format.h>
@@ -46,6 +50,29 @@ struct WindowOutput::State {
   EGLSurface surface = EGL_NO_SURFACE;
   std::string renderer;
   bool closeRequested = false;
+  // Input received and not taken yet: a fixed ring, so that receiving allocates nothing; the
+  // oldest gives way when it is full (counted).
+  std::array<Event, 256> input{};
+  std::size_t inputFirst = 0;
+  std::size_t inputCount = 0;
+  std::uint64_t inputDropped = 0;
+  bool pointerKnown = false;
+  int pointerX = 0, pointerY = 0;
+
+  void push(EventKind kind, std::uint16_t index, double value) {
+    if (inputCount == input.size()) {
+      inputFirst = (inputFirst + 1) % input.size();
+      --inputCount;
+      ++inputDropped;
+    }
+    Event& e = input[(inputFirst + inputCount) % input.size()];
+    e = Event{};
+    e.device = kOutputInputDevice;
+    e.kind = kind;
+    e.index = index;
+    e.value = value;
+    ++inputCount;
+  }
 
   ~State() {
     if (context) {
@@ -95,9 +122,40 @@ void WindowOutput::handleEvents() {
     } else if (event.type == ConfigureNotify && event.xconfigure.width > 0 && event.xconfigure.height > 0) {
       state_->size = {static_cast<std::uint32_t>(event.xconfigure.width),
                       static_cast<std::uint32_t>(event.xconfigure.height)};
+    } else if ((event.type == KeyPress || event.type == KeyRelease) && event.xkey.keycode >= 8) {
+      // X key codes are the kernel's plus 8 on evdev keymaps. A held key repeats as press after
+      // press (without detectable auto-repeat, releases in between): each press counts.
+      state_->push(EventKind::kKey, static_cast<std::uint16_t>(event.xkey.keycode - 8), event.type == KeyPress ? 1 : 0);
+    } else if (event.type == MotionNotify) {
+      if (state_->pointerKnown) {
+        if (event.xmotion.x != state_->pointerX)
+          state_->push(EventKind::kPointerMotion, 0, event.xmotion.x - state_->pointerX);
+        if (event.xmotion.y != state_->pointerY)
+          state_->push(EventKind::kPointerMotion, 1, event.xmotion.y - state_->pointerY);
+      }
+      state_->pointerKnown = true;
+      state_->pointerX = event.xmotion.x;
+      state_->pointerY = event.xmotion.y;
+    } else if ((event.type == ButtonPress || event.type == ButtonRelease) && event.xbutton.button >= Button1 &&
+               event.xbutton.button <= Button3) {
+      // X numbers left, middle, right 1, 2, 3; the wheel (4, 5) is not a pointer button.
+      state_->push(EventKind::kPointerButton, static_cast<std::uint16_t>(event.xbutton.button - Button1),
+                   event.type == ButtonPress ? 1 : 0);
     }
   }
 }
+
+std::size_t WindowOutput::takeInput(std::span<Event> into) {
+  handleEvents();
+  State& s = *state_;
+  const std::size_t n = std::min(into.size(), s.inputCount);
+  for (std::size_t i = 0; i < n; ++i) into[i] = s.input[(s.inputFirst + i) % s.input.size()];
+  s.inputFirst = (s.inputFirst + n) % s.input.size();
+  s.inputCount -= n;
+  return n;
+}
+
+std::uint64_t WindowOutput::inputDropped() const { return state_->inputDropped; }
 
 Result<void> WindowOutput::readFromServer(Image& out) {
   Display* d = state_->xDisplay.get();
@@ -188,7 +246,8 @@ Result<std::unique_ptr<WindowOutput>> WindowOutput::open(const OutputRequest& re
   }
   XSetWindowAttributes attributes{};
   attributes.colormap = XCreateColormap(x, root, info->visual, AllocNone);
-  attributes.event_mask = StructureNotifyMask;
+  attributes.event_mask =
+      StructureNotifyMask | KeyPressMask | KeyReleaseMask | PointerMotionMask | ButtonPressMask | ButtonReleaseMask;
   attributes.background_pixel = 0;
   attributes.border_pixel = 0;
   const Window window = XCreateWindow(x, root, 0, 0, size.width, size.height, 0, info->depth, InputOutput, info->visual,

@@ -4,7 +4,9 @@
 /// \brief A window on a desktop, for developing shows: X11 through EGL (on Wayland desktops it
 /// runs through XWayland).
 
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "render/output.h"
@@ -33,6 +35,10 @@ class WindowOutput final : public Output {
   [[nodiscard]] Result<void> beginFrame() override;
   [[nodiscard]] Result<void> present() override;
   [[nodiscard]] bool closeRequested() const override;
+  /// \brief Keys (X key codes less 8: the Linux key codes on X servers with evdev keymaps, as
+  /// Xorg, XWayland and Xvfb have), pointer motion and buttons the window received.
+  std::size_t takeInput(std::span<Event> into) override;
+  [[nodiscard]] std::uint64_t inputDropped() const override;
 
   /// \brief Copies what the X server shows in the window into `out` as RGBA8, top row first
   /// (after present()): the picture as it reached the display server.

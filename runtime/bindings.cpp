@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "runtime/navigation.h"
+
 namespace basalt::runtime {
 
 namespace {
@@ -20,6 +22,11 @@ constexpr struct {
     {Action::kTranslateZ, "translate_z"},
     {Action::kMoveZoomX, "move_zoom_x"},
     {Action::kMoveZoomY, "move_zoom_y"},
+    {Action::kWalk, "walk"},
+    {Action::kStrafe, "strafe"},
+    {Action::kRise, "rise"},
+    {Action::kTurn, "turn"},
+    {Action::kTilt, "tilt"},
 };
 
 // Turns further apart than this count as a fresh, slow turn for acceleration.
@@ -91,6 +98,11 @@ bool Bindings::turn(std::size_t dial, double turns, Nanos time, Show& show, bool
     case Action::kTranslateZ: show.translateGlobal({0, 0, amount}); return true;
     case Action::kMoveZoomX: zoomMove_.dx += amount; return true;
     case Action::kMoveZoomY: zoomMove_.dy += amount; return true;
+    case Action::kWalk: moveViewer(show, amount, 0, 0); return true;
+    case Action::kStrafe: moveViewer(show, 0, amount, 0); return true;
+    case Action::kRise: moveViewer(show, 0, 0, amount); return true;
+    case Action::kTurn: turnViewer(show, amount, 0); return true;
+    case Action::kTilt: turnViewer(show, 0, amount); return true;
   }
   return false;
 }

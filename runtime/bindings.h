@@ -32,6 +32,13 @@ enum class Action : std::uint8_t {
   kTranslateZ,
   kMoveZoomX,
   kMoveZoomY,
+  // The walk-through viewer (thesis §4.6, Appendix B), for scenes and facet views: `gain` scene
+  // units per turn for walk, strafe and rise, degrees per turn for turn and tilt.
+  kWalk,
+  kStrafe,
+  kRise,
+  kTurn,
+  kTilt,
 };
 
 /// \brief "rotate_x", "scale", "none", ... (the names a show manifest uses).

@@ -24,38 +24,48 @@ bool Navigator::apply(const Event& event, Show& show) {
     }
   }
   if (event.kind == EventKind::kPointerMotion) {
-    Viewer& v = show.viewer();
-    const auto degrees = static_cast<float>(event.value) * v.rotationSpeed;
-    // Moving the pointer right pans right (a turn clockwise seen from above, negative about Y);
-    // moving it forward (up the screen, negative y) tilts the view down.
-    if (event.index == 0) v.rotation.y -= degrees;
-    if (event.index == 1) v.rotation.x = std::clamp(v.rotation.x + degrees, -89.0f, 89.0f);
-    v.fromScene = true;
+    const auto degrees = static_cast<float>(event.value) * show.viewer().rotationSpeed;
+    // Moving the pointer right pans right; moving it forward (up the screen, negative y) tilts
+    // the view down.
+    if (event.index == 0) turnViewer(show, degrees, 0);
+    if (event.index == 1) turnViewer(show, 0, degrees);
     return true;
   }
   return false;
 }
 
 void Navigator::advance(double seconds, Show& show) {
-  Viewer& v = show.viewer();
-  const auto step = static_cast<float>(seconds) * v.positionSpeed;
+  const auto step = static_cast<float>(seconds) * show.viewer().positionSpeed;
   const float along = (forward_ ? 1.0f : 0.0f) - (back_ ? 1.0f : 0.0f);
   const float across = (right_ ? 1.0f : 0.0f) - (left_ ? 1.0f : 0.0f);
   const float vertical = (up_ ? 1.0f : 0.0f) - (down_ ? 1.0f : 0.0f);
   if (along == 0 && across == 0 && vertical == 0) return;
+  moveViewer(show, along * step, across * step, vertical * step, eyeHeight_);
+}
+
+void moveViewer(Show& show, float forward, float right, float up, float eyeHeight) {
+  Viewer& v = show.viewer();
   // Walking stays horizontal: the heading is the turn about Y; forward is -Z at heading 0.
   const float yaw = radians(v.rotation.y);
-  const Vec3 forward{-std::sin(yaw), 0, -std::cos(yaw)};
-  const Vec3 right{std::cos(yaw), 0, -std::sin(yaw)};
-  Vec3 p = v.position + forward * (along * step) + right * (across * step);
-  p.y += vertical * step;
+  const Vec3 ahead{-std::sin(yaw), 0, -std::cos(yaw)};
+  const Vec3 side{std::cos(yaw), 0, -std::sin(yaw)};
+  Vec3 p = v.position + ahead * forward + side * right;
+  p.y += up;
   p.x = std::clamp(p.x, v.mapMin.x, v.mapMax.x);
   p.y = std::clamp(p.y, v.mapMin.y, v.mapMax.y);
   p.z = std::clamp(p.z, v.mapMin.z, v.mapMax.z);
-  if (v.followTerrain && (along != 0 || across != 0)) {
-    if (auto ground = show.terrainHeightAt(p.x, p.z)) p.y = *ground + eyeHeight_;
+  if (v.followTerrain && (forward != 0 || right != 0)) {
+    if (auto ground = show.terrainHeightAt(p.x, p.z)) p.y = *ground + eyeHeight;
   }
   v.position = p;
+  v.fromScene = true;
+}
+
+void turnViewer(Show& show, float heading, float pitch) {
+  Viewer& v = show.viewer();
+  // To the right is clockwise seen from above: negative about Y.
+  v.rotation.y -= heading;
+  v.rotation.x = std::clamp(v.rotation.x + pitch, -89.0f, 89.0f);
   v.fromScene = true;
 }
 

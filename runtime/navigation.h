@@ -14,6 +14,15 @@
 
 namespace basalt::runtime {
 
+/// \brief Moves the viewer `forward` along its heading, `right` across it and `up` (scene units),
+/// within the map bounds; with `followTerrain` a horizontal move puts the eye `eyeHeight` above
+/// the ground. What the arrow keys and the walk, strafe and rise dial actions do.
+void moveViewer(Show& show, float forward, float right, float up, float eyeHeight = 1.7f);
+/// \brief Turns the viewer: `heading` degrees to the right (a clockwise turn seen from above) and
+/// `pitch` degrees down, the pitch kept within 89 degrees of level. What dragging the pointer and
+/// the turn and tilt dial actions do.
+void turnViewer(Show& show, float heading, float pitch);
+
 /// \brief Turns key and pointer events into viewer motion. Plain state, no allocation.
 class Navigator {
  public:

@@ -1,23 +1,32 @@
 // The window output for real, on an X server (Xvfb): the picture drawn into the window reaches
 // the X server and matches the headless render of the same frame; output detection picks the
 // window when a display server is there and headless when not; `basalt run --output window`
-// plays on it. Skips, saying so, when Xvfb is not installed.
+// plays on it; keys, pointer motion and buttons in the window become input events, and a show's
+// facet view is calibrated with the thesis' keys typed into its window. Skips, saying so, when
+// Xvfb is not installed.
 // Example failures: a window that stays black (wrong EGL config or a swap that never happens);
 // red and blue swapped on the way to the server; auto-detection opening headless on a desktop.
 
 #include <gtest/gtest.h>
 
+#include <X11/Xlib.h>
+#include <X11/keysym.h>
 #include <signal.h>
 #include <unistd.h>
+
+#include <fstream>
+#include <vector>
 
 #include <cstdlib>
 #include <string>
 #include <thread>
 
+#include "kiosk_process.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "render/window_output.h"
 #include "runtime/show/show.h"
+#include "support/polyhedra.h"
 #include "support/process.h"
 #include "support/test_paths.h"
 
@@ -193,6 +202,193 @@ TEST(WindowOutput, BasaltRunPlaysInAWindow) {
                            {{"DISPLAY", x.display()}});
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find("output: window 200x150 on X display"), std::string::npos) << r.output;
+}
+
+/// A second client of the X server, as a person's keyboard and mouse: finds a window by its title
+/// and sends it events the way the server delivers them.
+class XClient {
+ public:
+  XClient() : d_(XOpenDisplay(nullptr)) {}
+  ~XClient() {
+    if (d_) XCloseDisplay(d_);
+  }
+  XClient(const XClient&) = delete;
+  XClient& operator=(const XClient&) = delete;
+  [[nodiscard]] bool open() const { return d_ != nullptr; }
+  /// The server's key code for a key symbol (its keymap, not a guess).
+  unsigned keycode(KeySym symbol) const { return XKeysymToKeycode(d_, symbol); }
+
+  /// The top-level window whose title starts with `title`, waiting up to 10 s for it; 0 if none.
+  Window find(const std::string& title) const {
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      Window root = 0, parent = 0;
+      Window* children = nullptr;
+      unsigned count = 0;
+      Window found = 0;
+      if (XQueryTree(d_, DefaultRootWindow(d_), &root, &parent, &children, &count)) {
+        for (unsigned i = 0; i < count && !found; ++i) {
+          char* name = nullptr;
+          if (XFetchName(d_, children[i], &name) && name) {
+            if (std::string(name).starts_with(title)) found = children[i];
+            XFree(name);
+          }
+        }
+        if (children) XFree(children);
+      }
+      if (found) return found;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return 0;
+  }
+
+  void key(Window w, unsigned code, bool press, unsigned state = 0) const {
+    XEvent e{};
+    e.xkey.type = press ? KeyPress : KeyRelease;
+    e.xkey.display = d_;
+    e.xkey.window = w;
+    e.xkey.root = DefaultRootWindow(d_);
+    e.xkey.keycode = code;
+    e.xkey.state = state;
+    e.xkey.same_screen = True;
+    send(w, press ? KeyPressMask : KeyReleaseMask, e);
+  }
+  void motion(Window w, int x, int y) const {
+    XEvent e{};
+    e.xmotion.type = MotionNotify;
+    e.xmotion.display = d_;
+    e.xmotion.window = w;
+    e.xmotion.root = DefaultRootWindow(d_);
+    e.xmotion.x = x;
+    e.xmotion.y = y;
+    e.xmotion.same_screen = True;
+    send(w, PointerMotionMask, e);
+  }
+  void button(Window w, unsigned number, bool press) const {
+    XEvent e{};
+    e.xbutton.type = press ? ButtonPress : ButtonRelease;
+    e.xbutton.display = d_;
+    e.xbutton.window = w;
+    e.xbutton.root = DefaultRootWindow(d_);
+    e.xbutton.button = number;
+    e.xbutton.same_screen = True;
+    send(w, press ? ButtonPressMask : ButtonReleaseMask, e);
+  }
+
+ private:
+  void send(Window w, long mask, XEvent& e) const {
+    XSendEvent(d_, w, False, mask, &e);
+    XSync(d_, False);
+  }
+  Display* d_;
+};
+
+TEST(WindowOutput, KeysAndThePointerBecomeInputEvents) {
+  // Makes sure what a person does in the window reaches the show as Basalt's input events: Linux
+  // key codes (the server's key code for 'a' is KEY_A, 30, plus 8), pointer motion as deltas,
+  // buttons numbered from 0. Example failure: X key codes passed on unchanged, so the thesis'
+  // calibration keys never match.
+  Xvfb x;
+  REQUIRE_XVFB(x);
+  OutputRequest request;
+  request.kind = OutputKind::kWindow;
+  request.size = {160, 120};
+  request.title = "Basalt input test";
+  auto window = WindowOutput::open(request);
+  ASSERT_TRUE(window) << window.error().describe();
+  drawDefaultShow(**window, 1);
+  ASSERT_TRUE((*window)->present());
+  XClient person;
+  ASSERT_TRUE(person.open());
+  const Window w = person.find("Basalt input test");
+  ASSERT_NE(w, 0u);
+  const unsigned a = person.keycode(XK_a);
+  EXPECT_EQ(a, 30u + 8u) << "Xvfb's keymap is not evdev's";
+  person.key(w, a, true);
+  person.key(w, a, false);
+  person.motion(w, 10, 10);  // where the pointer is: no motion yet
+  person.motion(w, 15, 7);
+  person.button(w, 3, true);
+  person.button(w, 3, false);
+  std::vector<Event> got;
+  std::array<Event, 4> buffer;  // smaller than what arrives: takeInput hands the rest out next time
+  for (int attempt = 0; attempt < 100 && got.size() < 6; ++attempt) {
+    while (const std::size_t n = (*window)->takeInput(buffer))
+      got.insert(got.end(), buffer.begin(), buffer.begin() + n);
+    if (got.size() < 6) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(got.size(), 6u);
+  const struct {
+    EventKind kind;
+    std::uint16_t index;
+    double value;
+  } expected[6] = {{EventKind::kKey, 30, 1},          {EventKind::kKey, 30, 0},
+                   {EventKind::kPointerMotion, 0, 5}, {EventKind::kPointerMotion, 1, -3},
+                   {EventKind::kPointerButton, 2, 1}, {EventKind::kPointerButton, 2, 0}};
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(got[i].kind, expected[i].kind) << i;
+    EXPECT_EQ(got[i].index, expected[i].index) << i;
+    EXPECT_EQ(got[i].value, expected[i].value) << i;
+    EXPECT_EQ(got[i].device, kOutputInputDevice) << i;
+  }
+  EXPECT_EQ((*window)->inputDropped(), 0u);
+}
+
+TEST(WindowOutput, TheCalibrationKeysTypedIntoTheWindowCalibrateTheFacetView) {
+  // A technician at the show's window: Shift and ':' (the thesis' Xskew, small step up) reach
+  // the facet view, whose calibration the control server then reports; Shift and 'S' turn the base
+  // side.
+  // Example failure: keys read by the window but never handed to the views.
+  Xvfb x;
+  REQUIRE_XVFB(x);
+  const auto dir = test::writeShow("window-calibration", R"(
+[show]
+name = "Keys"
+entry = "default"
+fps = 30
+
+[output]
+kind = "window"
+size = "160x120"
+
+[[views]]
+name = "front"
+kind = "facet"
+cave = "display.cave"
+
+[status]
+listen = "127.0.0.1:0"
+token_file = "token"
+)");
+  const std::string token = "0123456789abcdef0123456789abcdef";
+  std::ofstream(dir / "token") << token << "\n";
+  std::ofstream(dir / "display.obj") << test::cubeDisplayObj();
+  std::ofstream(dir / "display.cave") << "model display.obj\nfacet[5]\n";
+  std::string why;
+  auto show = test::RunningShow::start({(dir / "show.toml").string(), "--no-resume"}, {{"DISPLAY", x.display()}}, why);
+  ASSERT_TRUE(show) << why;
+  XClient person;
+  ASSERT_TRUE(person.open());
+  const Window w = person.find("Basalt: Keys");
+  ASSERT_NE(w, 0u) << show->process().outputSoFar();
+  const unsigned shift = person.keycode(XK_Shift_L), semicolon = person.keycode(XK_semicolon);
+  const unsigned s = person.keycode(XK_s);
+  person.key(w, shift, true);
+  person.key(w, semicolon, true, ShiftMask);
+  person.key(w, semicolon, false, ShiftMask);
+  person.key(w, s, true, ShiftMask);
+  person.key(w, s, false, ShiftMask);
+  person.key(w, shift, false);
+  const std::string bearer = "Bearer " + token;
+  std::string settings;
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    settings = show->post("/control/calibrate", "", bearer).body;
+    if (settings.find("side[1]") != std::string::npos) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_NE(settings.find("Xskew[0.5]"), std::string::npos) << settings;
+  EXPECT_NE(settings.find("side[1]"), std::string::npos) << settings;
+  show->process().signal(SIGTERM);
+  EXPECT_EQ(show->process().wait(std::chrono::seconds(20)).exitCode, 0);
 }
 
 }  // namespace

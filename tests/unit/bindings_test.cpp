@@ -114,5 +114,44 @@ TEST(BindingsExtended, ZoomDialsMoveThePictureNotTheObject) {
   EXPECT_EQ(actionName(Action::kMoveZoomY), "move_zoom_y");
 }
 
+TEST(BindingsExtended, ViewerDialsWalkAndTurnTheViewer) {
+  // A dial box bound to the walk-through viewer (thesis §4.6): walking goes along the heading,
+  // turning right turns the heading, the map bounds hold, and the object itself stays put.
+  // Example failure: a walk dial that moves the object instead of the viewer, or walks north
+  // whatever the heading.
+  Bindings b = Bindings::lavaDefaults();
+  b.setDial(0, {Action::kWalk, 2});
+  b.setDial(1, {Action::kTurn, 90});
+  b.setDial(2, {Action::kTilt, 90});
+  b.setDial(3, {Action::kRise, 2});
+  b.setDial(4, {Action::kStrafe, 2});
+  Show show = Show::makeDefault();
+  show.viewer().mapMin = {-10, -10, -10};
+  show.viewer().mapMax = {10, 10, 10};
+  const Mat4 object = show.position().global;
+  ASSERT_TRUE(b.apply(dial(0, 0.5), show));  // one unit ahead: -Z at heading 0
+  EXPECT_NEAR(show.viewer().position.z, -1.0f, 1e-5f);
+  EXPECT_NEAR(show.viewer().position.x, 0.0f, 1e-5f);
+  EXPECT_TRUE(show.viewer().fromScene);
+  ASSERT_TRUE(b.apply(dial(1, 1.0), show));  // a quarter turn to the right: facing +X
+  EXPECT_NEAR(show.viewer().rotation.y, -90.0f, 1e-4f);
+  ASSERT_TRUE(b.apply(dial(0, 0.5), show));
+  EXPECT_NEAR(show.viewer().position.x, 1.0f, 1e-5f);
+  EXPECT_NEAR(show.viewer().position.z, -1.0f, 1e-5f);
+  ASSERT_TRUE(b.apply(dial(4, 0.5), show));  // sideways to the right of +X is +Z
+  EXPECT_NEAR(show.viewer().position.z, 0.0f, 1e-5f);
+  ASSERT_TRUE(b.apply(dial(3, 0.25), show));
+  EXPECT_NEAR(show.viewer().position.y, 0.5f, 1e-5f);
+  ASSERT_TRUE(b.apply(dial(2, 5.0), show));  // tilting stops short of straight down
+  EXPECT_NEAR(show.viewer().rotation.x, 89.0f, 1e-4f);
+  ASSERT_TRUE(b.apply(dial(0, 100.0), show));  // the map's edge holds
+  EXPECT_NEAR(show.viewer().position.x, 10.0f, 1e-5f);
+  EXPECT_EQ(show.position().global.m, object.m) << "the object does not move";
+  for (const char* name : {"walk", "strafe", "rise", "turn", "tilt"}) {
+    ASSERT_TRUE(actionByName(name)) << name;
+    EXPECT_EQ(actionName(*actionByName(name)), name);
+  }
+}
+
 }  // namespace
 }  // namespace basalt::runtime
