@@ -24,8 +24,12 @@ namespace basalt::devices {
 /// handleReport() on the reader thread; the decoder and the event buffer belong to the reader.
 class DecodingDialBox : public DialBox {
  protected:
-  DecodingDialBox(DeviceInfo info, int dials, int buttons, DialDecoder decoder, const Clock& clock)
-      : DialBox(std::move(info), dials, buttons, true), decoder_(std::move(decoder)), clock_(clock) {}
+  /// \brief The dial and button counts are the decoder's (read before it moves into place: the
+  /// base class is built first).
+  DecodingDialBox(DeviceInfo info, DialDecoder decoder, const Clock& clock)
+      : DialBox(std::move(info), decoder.dialCount(), decoder.buttonCount(), true),
+        decoder_(std::move(decoder)),
+        clock_(clock) {}
 
   /// \brief Forgets the decoder's state and starts readLoop() on the reader thread.
   void startReader() {

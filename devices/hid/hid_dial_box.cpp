@@ -64,7 +64,7 @@ std::string busOf(hid_bus_type bus) {
 class HidrawDialBox final : public DecodingDialBox {
  public:
   HidrawDialBox(DeviceInfo info, std::vector<std::uint8_t> descriptor, DialDecoder decoder, const Clock& clock)
-      : DecodingDialBox(std::move(info), decoder.dialCount(), decoder.buttonCount(), std::move(decoder), clock) {
+      : DecodingDialBox(std::move(info), std::move(decoder), clock) {
     setReportDescriptor(std::move(descriptor));
   }
   ~HidrawDialBox() override { close(); }

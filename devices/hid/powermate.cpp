@@ -71,7 +71,7 @@ const std::vector<std::uint8_t> kFallbackDescriptor = {0x06, 0x00, 0xff, 0x09, 0
 class PowerMateDialBox final : public DecodingDialBox {
  public:
   PowerMateDialBox(DeviceInfo info, const Clock& clock)
-      : DecodingDialBox(std::move(info), 1, 1, *DialDecoder::create(kGriffinVendor, kPowerMateProduct, {}), clock) {}
+      : DecodingDialBox(std::move(info), *DialDecoder::create(kGriffinVendor, kPowerMateProduct, {}), clock) {}
   ~PowerMateDialBox() override { close(); }
 
  private:
