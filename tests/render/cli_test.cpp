@@ -68,19 +68,6 @@ TEST(Cli, DefaultSnapshotGoesToTheOutputFolder) {
   EXPECT_EQ(image->height, 200u);
 }
 
-/// True once the process blocks `sig` (its SigBlk mask in /proc), i.e. reads it as an event.
-bool signalBlocked(pid_t pid, int sig) {
-  std::FILE* f = std::fopen(("/proc/" + std::to_string(pid) + "/status").c_str(), "r");
-  if (!f) return false;
-  char line[256];
-  unsigned long long mask = 0;
-  while (std::fgets(line, sizeof line, f)) {
-    if (std::sscanf(line, "SigBlk: %llx", &mask) == 1) break;
-  }
-  std::fclose(f);
-  return (mask >> (sig - 1) & 1ULL) != 0;
-}
-
 /// Runs `basalt run --headless` with no frame limit until `sig`, then checks it stopped cleanly
 /// and wrote the snapshot of its last frame.
 void stopsCleanlyOn(int sig, const char* name) {
@@ -92,9 +79,7 @@ void stopsCleanlyOn(int sig, const char* name) {
   ASSERT_TRUE(p.started());
   // Signal once basalt handles the signal (blocked, read through its event loop): a fixed sleep
   // lost the race on a loaded machine and the default action killed it mid-start.
-  for (int i = 0; i < 400 && !signalBlocked(p.pid(), sig); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
+  test::waitUntilSignalBlocked(p.pid(), sig);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   p.signal(sig);
   const auto r = p.wait(std::chrono::seconds(20));

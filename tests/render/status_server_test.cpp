@@ -103,6 +103,20 @@ TEST_F(StatusServer, HealthReportsTheShowItsFramesAndItsDevices) {
   EXPECT_NE(h.body.find("\"frames\": {\n    \"total\": "), std::string::npos) << h.body;
   EXPECT_NE(h.body.find("\"last_errors\": ["), std::string::npos) << h.body;
   EXPECT_NE(h.body.find("\"uptime_seconds\": "), std::string::npos) << h.body;
+  // Each device says since when it is in its state (ISO 8601), frames have a rate, and the
+  // streams are listed (none in this show).
+  EXPECT_TRUE(std::regex_search(
+      h.body,
+      std::regex(R"re("name": "dials", [^}]*"state": "live", "since": "[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:.]+)re")))
+      << h.body;
+  EXPECT_TRUE(std::regex_search(
+      h.body,
+      std::regex(R"re("name": "knob", [^}]*"state": "absent", "since": "[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:.]+)re")))
+      << h.body;
+  std::smatch rate;
+  ASSERT_TRUE(std::regex_search(h.body, rate, std::regex(R"re("per_second": ([0-9.]+))re"))) << h.body;
+  EXPECT_GT(std::stod(rate[1]), 0.0) << h.body;
+  EXPECT_NE(h.body.find("\"streams\": []"), std::string::npos) << h.body;
 }
 
 TEST_F(StatusServer, MetricsAreValidPrometheusText) {

@@ -7,7 +7,12 @@
 
 #include <gtest/gtest.h>
 
+#include <signal.h>
+
+#include <chrono>
+#include <regex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "media/image_io.h"
@@ -78,6 +83,33 @@ TEST(VideoCli, RecordFramesStopsTheRecordingNotTheShow) {
   EXPECT_NE(r.output.find("40 frames"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("recorded 10 frames"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("Motion-JPEG in Matroska"), std::string::npos) << r.output;
+}
+
+TEST(VideoCli, RecordsUntilStoppedAndFinishesTheFile) {
+  // LAVA's "Rec" until stopped: a live show recorded with no frame limit, ended by Ctrl-C, leaves
+  // a finished MP4 (its index written) holding every frame it says it recorded.
+  // Example failure: an MP4 cut off at the signal, which no player opens.
+  std::string why;
+  if (!eglAvailable(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  const auto file = test::scratchDir("video-cli-record-stop") / "live.mp4";
+  test::Process p = test::Process::start({(test::binaryDir() / "basalt").string(), "run", "--headless", "--size",
+                                          "160x120", "--fps", "15", "--record", file.string()});
+  ASSERT_TRUE(p.started());
+  ASSERT_TRUE(test::waitUntilSignalBlocked(p.pid(), SIGINT)) << p.outputSoFar();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  p.signal(SIGINT);
+  const auto r = p.wait(std::chrono::seconds(60));
+  ASSERT_FALSE(r.timedOut) << r.output;
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::smatch recorded;
+  ASSERT_TRUE(std::regex_search(r.output, recorded, std::regex("recorded ([0-9]+) frames to ")))
+      << "says how much it recorded: " << r.output;
+  const std::int64_t frames = std::stoll(recorded[1]);
+  EXPECT_GT(frames, 5) << r.output;
+  media::MovieInfo info;
+  EXPECT_EQ(countFrames(file, info), frames) << "the file holds what was recorded";
+  EXPECT_EQ(info.width, 160u);
+  EXPECT_NEAR(info.fps, 15, 0.01);
 }
 
 TEST(VideoCli, FullDiskIsAClearErrorAndTheShowGoesOn) {

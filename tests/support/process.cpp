@@ -7,7 +7,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstring>
+#include <string>
+#include <thread>
 #include <utility>
 
 extern char** environ;
@@ -124,6 +127,27 @@ ProcessResult run(const std::vector<std::string>& argv, const std::map<std::stri
     return r;
   }
   return p.wait(limit);
+}
+
+bool signalBlocked(pid_t pid, int sig) {
+  std::FILE* f = std::fopen(("/proc/" + std::to_string(pid) + "/status").c_str(), "r");
+  if (!f) return false;
+  char line[256];
+  unsigned long long mask = 0;
+  while (std::fgets(line, sizeof line, f)) {
+    if (std::sscanf(line, "SigBlk: %llx", &mask) == 1) break;
+  }
+  std::fclose(f);
+  return (mask >> (sig - 1) & 1ULL) != 0;
+}
+
+bool waitUntilSignalBlocked(pid_t pid, int sig, std::chrono::milliseconds limit) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (!signalBlocked(pid, sig)) {
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return true;
 }
 
 }  // namespace basalt::test

@@ -50,4 +50,10 @@ class Process {
 ProcessResult run(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env = {},
                   std::chrono::milliseconds limit = std::chrono::seconds(60));
 
+/// \brief True once process `pid` blocks signal `sig` (its SigBlk mask in /proc), i.e. reads it
+/// as an event: from then on the signal stops it cleanly instead of killing it mid-start.
+bool signalBlocked(pid_t pid, int sig);
+/// \brief Waits up to `limit` for signalBlocked(pid, sig); false when it never came.
+bool waitUntilSignalBlocked(pid_t pid, int sig, std::chrono::milliseconds limit = std::chrono::seconds(20));
+
 }  // namespace basalt::test
