@@ -8,11 +8,16 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cctype>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "media/movie_player.h"
 #include "support/movie_playback.h"
+#include "support/process.h"
 #include "support/test_paths.h"
 
 namespace basalt::media {
@@ -125,6 +130,77 @@ TEST(MovieFileErrors, MissingFileFailsAtOnceNamingIt) {
   EXPECT_NE(r.error().describe().find("/nonexistent/movie.mp4"), std::string::npos);
   EXPECT_EQ((*player)->frameAt(Nanos{0}).get(), nullptr);
 }
+
+}  // namespace
+}  // namespace basalt::media
+
+// The colorimetry a decoder reports reaches the frames (and so the shader's conversion): an
+// H.264 clip flagged BT.709 plays as BT.709 limited range, one flagged BT.601 as BT.601, and
+// Motion-JPEG (full-range JPEG) as BT.601 full range. Clips made with GStreamer's own tools.
+// Example failure: every stream converted as BT.601 limited, so HD video and JPEG cameras show
+// shifted colours.
+namespace basalt::media {
+namespace {
+
+std::string gstLaunchPath() {
+  for (const char* dir : {"/usr/bin", "/bin", "/usr/local/bin"}) {
+    const std::filesystem::path p = std::filesystem::path(dir) / "gst-launch-1.0";
+    if (::access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return {};
+}
+
+struct ColorimetryCase {
+  const char* name;
+  const char* caps;     // raw caps into the encoder
+  const char* encoder;  // encoder and muxer, gst-launch syntax
+  Colorimetry expected;
+};
+
+void PrintTo(const ColorimetryCase& c, std::ostream* os) { *os << c.name; }
+
+class StreamColorimetry : public ::testing::TestWithParam<ColorimetryCase> {};
+
+TEST_P(StreamColorimetry, ReachesTheFrames) {
+  const ColorimetryCase& c = GetParam();
+  const std::string launch = gstLaunchPath();
+  if (launch.empty()) GTEST_SKIP() << "gst-launch-1.0 is not installed (gstreamer1.0-tools)";
+  const auto file = test::scratchDir("stream-colorimetry") / (std::string(c.name) + ".mkv");
+  std::vector<std::string> argv{launch, "-q", "videotestsrc", "num-buffers=10", "!", c.caps, "!"};
+  std::istringstream encoder(c.encoder);
+  for (std::string word; encoder >> word;) argv.push_back(word);
+  argv.insert(argv.end(), {"!", "matroskamux", "!", "filesink", "location=" + file.string()});
+  const auto made = test::run(argv, {}, std::chrono::seconds(60));
+  ASSERT_EQ(made.exitCode, 0) << made.output;
+  auto player = MoviePlayer::create({});
+  ASSERT_TRUE(player) << player.error().describe();
+  ASSERT_TRUE((*player)->load(file));
+  auto info = (*player)->waitUntilLoaded(std::chrono::seconds(20));
+  ASSERT_TRUE(info) << info.error().describe();
+  (*player)->play();
+  ASSERT_TRUE((*player)->waitForFrameDue(Nanos{0}, std::chrono::seconds(10)));
+  FrameRef frame = (*player)->frameAt(Nanos{0});
+  ASSERT_TRUE(frame);
+  ASSERT_TRUE(isYuv(frame->format)) << "the decoder gave RGB; nothing to convert";
+  EXPECT_EQ(frame->colorimetry.matrix, c.expected.matrix) << c.name;
+  EXPECT_EQ(frame->colorimetry.range, c.expected.range) << c.name;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Decoded, StreamColorimetry,
+    ::testing::Values(ColorimetryCase{"h264_bt709",
+                                      "video/x-raw,format=I420,width=320,height=240,colorimetry=bt709",
+                                      "x264enc speed-preset=ultrafast",
+                                      {Colorimetry::Matrix::kBt709, Colorimetry::Range::kLimited}},
+                      ColorimetryCase{"h264_bt601",
+                                      "video/x-raw,format=I420,width=320,height=240,colorimetry=bt601",
+                                      "x264enc speed-preset=ultrafast",
+                                      {Colorimetry::Matrix::kBt601, Colorimetry::Range::kLimited}},
+                      ColorimetryCase{"mjpeg",
+                                      "video/x-raw,format=I420,width=320,height=240",
+                                      "jpegenc",
+                                      {Colorimetry::Matrix::kBt601, Colorimetry::Range::kFull}}),
+    [](const ::testing::TestParamInfo<ColorimetryCase>& i) { return std::string(i.param.name); });
 
 }  // namespace
 }  // namespace basalt::media
