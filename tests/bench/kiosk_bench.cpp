@@ -222,6 +222,11 @@ BENCHMARK_CAPTURE(firstFrame, lavaScript, "lava-script")
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3)
     ->Repetitions(3);
+BENCHMARK_CAPTURE(firstFrame, cubeCave, "cube-cave")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3)
+    ->Repetitions(3);
 BENCHMARK(reloadGap)->UseManualTime()->Iterations(1)->Repetitions(1);
 BENCHMARK(statusServerCost)->UseManualTime()->Iterations(1)->Repetitions(1);
 
@@ -230,7 +235,8 @@ BENCHMARK(statusServerCost)->UseManualTime()->Iterations(1)->Repetitions(1);
 int main(int argc, char** argv) {
   return basalt::bench::runBenchmarks(argc, argv, [](const basalt::bench::Medians& m) {
     const auto floor = m.find("processStartFloor");
-    for (const char* name : {"defaultShowBuiltIn", "defaultDemo", "videoWall", "cameraSculpture", "lavaScript"}) {
+    for (const char* name :
+         {"defaultShowBuiltIn", "defaultDemo", "videoWall", "cameraSculpture", "lavaScript", "cubeCave"}) {
       const auto it = m.find(std::string("firstFrame/") + name);
       if (it == m.end() || floor == m.end()) {
         std::printf("kiosk start-up %s: no figure (a benchmark failed)\n", name);
