@@ -75,6 +75,7 @@ Result<std::unique_ptr<VideoStreams>> VideoStreams::create(const std::vector<Mov
                                                            runtime::Show& show, render::Renderer& renderer,
                                                            bool manualClock) {
   std::unique_ptr<VideoStreams> v(new VideoStreams(renderer, manualClock));
+  v->show_ = &show;
   for (const MovieStreamSpec& spec : specs) {
     auto stream = std::make_unique<Stream>();
     stream->spec = spec;
@@ -102,6 +103,9 @@ Result<std::unique_ptr<VideoStreams>> VideoStreams::create(const std::vector<Mov
       log::warn(kLogKiosk,
                 "movie '{}': the show has no part of that name; the movie is a texture named '{}' for later use",
                 spec.name, spec.name);
+    } else {
+      // Only the Zoom picture shows it: drawn from the decoder's planes in one pass.
+      stream->texture->setPictureOnly(true);
     }
     v->streams_.push_back(std::move(stream));
   }
@@ -112,6 +116,17 @@ Result<std::unique_ptr<VideoStreams>> VideoStreams::create(const std::vector<Mov
   }
   return v;
 }
+
+namespace {
+/// Whether a part of `show` shows the texture `name` (allocates nothing).
+bool usedOnAPart(const runtime::Show& show, std::string_view name) {
+  for (std::size_t i = 0; i < show.partCount(); ++i) {
+    const runtime::PartState& p = show.part(static_cast<runtime::PartId>(i));
+    if (p.texture == name || p.reflectionTexture == name) return true;
+  }
+  return false;
+}
+}  // namespace
 
 Result<void> VideoStreams::beforeDraw(const FrameContext& frame) {
   if (zoomDials_) {
@@ -131,6 +146,9 @@ Result<void> VideoStreams::beforeDraw(const FrameContext& frame) {
       if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) s->texture->showFallback();
     }
     if (state == media::MovieState::kFailed) continue;
+    // A part that takes up a picture-only stream's texture (a script's texture command) gets it
+    // converted from then on.
+    if (s->texture->pictureOnly() && usedOnAPart(*show_, s->spec.name)) s->texture->setPictureOnly(false);
     auto changed = s->texture->update(f);
     if (!changed) {
       log::error(kLogKiosk, "{}; showing the fallback texture", changed.error().describe());
@@ -155,7 +173,7 @@ Result<void> VideoStreams::afterDraw(const FrameContext&, render::Output& output
     const double aspect = s->player->info().pixelAspect;
     s->zoomRect.width = static_cast<float>(view.size.width * s->spec.zoom->scale * (aspect > 0 ? aspect : 1.0));
     s->zoomRect.height = static_cast<float>(view.size.height * s->spec.zoom->scale);
-    overlay_->draw(view, s->zoomRect, output.size());
+    s->texture->drawPicture(*overlay_, s->zoomRect, output.size());
   }
   return {};
 }

@@ -80,6 +80,7 @@ class VideoStreams final : public FrameParticipant {
   struct Stream;
   VideoStreams(render::Renderer& renderer, bool manualClock);
   render::Renderer& renderer_;
+  runtime::Show* show_ = nullptr;  // borrowed: the show whose parts may name a stream's texture
   bool manualClock_;
   std::vector<std::unique_ptr<Stream>> streams_;
   std::unique_ptr<render::PictureOverlay> overlay_;

@@ -15,6 +15,7 @@
 #include <GLES2/gl2ext.h>
 
 #include <array>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -364,24 +365,32 @@ Result<void> StreamTexture::importDmabuf(const Frame& frame) {
   return {};
 }
 
-Result<void> StreamTexture::convert(const Frame& frame) {
+Result<void> StreamTexture::convert(const Uploaded& planes) {
   Gpu& g = *gpu_;
-  const int layout = layoutOf(frame.format);
+  glBindFramebuffer(GL_FRAMEBUFFER, g.fbo.id());
+  glViewport(0, 0, static_cast<GLsizei>(g.width), static_cast<GLsizei>(g.height));
+  auto drawn = drawPlanes(planes, {-1.0f, -1.0f, 1.0f, 1.0f}, false);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (drawn) converted_ = true;
+  return drawn;
+}
+
+Result<void> StreamTexture::drawPlanes(const Uploaded& planes, const std::array<float, 4>& ndc, bool flip) {
+  Gpu& g = *gpu_;
+  const int layout = layoutOf(planes.format);
   ConversionProgram& c = g.programs[static_cast<std::size_t>(layout)];
   if (!c.program) {
     auto built = buildConversion(layout);
     if (!built) return std::unexpected(built.error());
     c = std::move(*built);
   }
-  glBindFramebuffer(GL_FRAMEBUFFER, g.fbo.id());
-  glViewport(0, 0, static_cast<GLsizei>(g.width), static_cast<GLsizei>(g.height));
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
   glUseProgram(c.program.id());
   std::array<float, 9> m{};
   std::array<float, 3> offset{};
-  colorMatrix(frame.colorimetry, m, offset);
+  colorMatrix(planes.colorimetry, m, offset);
   // Columns of m are the Y, U and V contributions; the bias is -m * offset.
   glUniform3f(c.yCoef, m[0], m[1], m[2]);
   glUniform3f(c.uCoef, m[3], m[4], m[5]);
@@ -389,17 +398,17 @@ Result<void> StreamTexture::convert(const Frame& frame) {
   glUniform3f(c.bias, -(m[0] * offset[0] + m[3] * offset[1] + m[6] * offset[2]),
               -(m[1] * offset[0] + m[4] * offset[1] + m[7] * offset[2]),
               -(m[2] * offset[0] + m[5] * offset[1] + m[8] * offset[2]));
-  glUniform4f(c.rect, -1.0f, -1.0f, 1.0f, 1.0f);
-  glUniform1i(c.flip, 0);
+  glUniform4f(c.rect, ndc[0], ndc[1], ndc[2], ndc[3]);
+  glUniform1i(c.flip, flip ? 1 : 0);
   if (c.chromaScale >= 0) {
-    const std::uint32_t cw = (frame.width + 1) / 2, ch = (frame.height + 1) / 2;
-    glUniform2f(c.chromaScale, static_cast<float>(frame.width) / static_cast<float>(2 * cw),
-                static_cast<float>(frame.height) / static_cast<float>(2 * ch));
+    const std::uint32_t cw = (planes.width + 1) / 2, ch = (planes.height + 1) / 2;
+    glUniform2f(c.chromaScale, static_cast<float>(planes.width) / static_cast<float>(2 * cw),
+                static_cast<float>(planes.height) / static_cast<float>(2 * ch));
   }
   // Mirrored: the target's left column is the frame's right one.
-  glUniform1i(c.mirrorWidth, mirror_ ? static_cast<GLint>(frame.width) : 0);
+  glUniform1i(c.mirrorWidth, mirror_ ? static_cast<GLint>(planes.width) : 0);
   // YV12 stores V before U: bind the planes so that unit 1 is always U.
-  const bool swapUv = frame.format == PixelFormat::kYv12;
+  const bool swapUv = planes.format == PixelFormat::kYv12;
   for (int i = 0; i < 3; ++i) {
     int source = i;
     if (swapUv && i > 0) source = 3 - i;
@@ -414,8 +423,68 @@ Result<void> StreamTexture::convert(const Frame& frame) {
     glBindTexture(GL_TEXTURE_2D, 0);
   }
   glUseProgram(0);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return {};
+}
+
+namespace {
+/// Layouts a picture can be drawn from straight: planar, sampled with texture() through the
+/// picture's own coordinates (the packed ones fetch by fragment position, which only the
+/// conversion pass's one-to-one target gives).
+bool drawableFromPlanes(PixelFormat f) {
+  return f == PixelFormat::kI420 || f == PixelFormat::kYv12 || f == PixelFormat::kNv12 || f == PixelFormat::kNv21;
+}
+}  // namespace
+
+void StreamTexture::setPictureOnly(bool pictureOnly) {
+  if (pictureOnly == pictureOnly_) return;
+  pictureOnly_ = pictureOnly;
+  if (!pictureOnly_ && !converted_) (void)ensureConverted();
+}
+
+Result<void> StreamTexture::ensureConverted() {
+  if (converted_ || fallback_ || uploaded_.format == PixelFormat::kUnknown) return {};
+  return convert(uploaded_);
+}
+
+void StreamTexture::drawPicture(PictureOverlay& overlay, const PictureRect& rect, Size viewport, float opacity) {
+  if (fallback_ || path_ == UploadPath::kNone || viewport.width == 0 || viewport.height == 0) {
+    if (fallback_) overlay.draw(view_, rect, viewport, opacity);
+    return;
+  }
+  if (pictureOnly_ && opacity >= 1.0f && drawableFromPlanes(uploaded_.format)) {
+    const auto vw = static_cast<float>(viewport.width), vh = static_cast<float>(viewport.height);
+    // Pixels from the top-left to normalised device coordinates (y up).
+    const float x0 = rect.x / vw * 2.0f - 1.0f, x1 = (rect.x + rect.width) / vw * 2.0f - 1.0f;
+    const float y1 = 1.0f - rect.y / vh * 2.0f, y0 = 1.0f - (rect.y + rect.height) / vh * 2.0f;
+    glViewport(0, 0, static_cast<GLsizei>(viewport.width), static_cast<GLsizei>(viewport.height));
+    // At the frame's own size the planes are read texel by texel (nearest: a plain load in a
+    // software renderer); scaled, they are filtered as the texture path filters its texture.
+    // (Imported dmabuf planes are filtered already.)
+    const bool scaled = path_ == UploadPath::kPlanes &&
+                        (std::lround(rect.width) != uploaded_.width || std::lround(rect.height) != uploaded_.height);
+    auto filter = [this](GLenum f) {
+      for (int i = 0; i < gpu_->planeCount; ++i) {
+        glBindTexture(GL_TEXTURE_2D, gpu_->planes[static_cast<std::size_t>(i)].id());
+        setSampling(f);
+      }
+      glBindTexture(GL_TEXTURE_2D, 0);
+    };
+    if (scaled) filter(GL_LINEAR);
+    auto drawn = drawPlanes(uploaded_, {x0, y0, x1, y1}, true);
+    if (scaled) filter(GL_NEAREST);
+    if (drawn) {
+      ++directPictures_;
+      return;
+    }
+  }
+  // The texture path: the caller's framebuffer stays bound around an on-demand conversion.
+  if (!converted_) {
+    GLint bound = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &bound);
+    (void)ensureConverted();
+    glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(bound));
+  }
+  overlay.draw(view_, rect, viewport, opacity);
 }
 
 void StreamTexture::setMirror(bool mirror) {
@@ -449,11 +518,18 @@ Result<bool> StreamTexture::update(const FrameRef& ref) {
   if (path == UploadPath::kPlanes && frame.format == PixelFormat::kRgba8 && !mirror_) {
     // Already what the renderer samples: straight into the target, no pass.
     if (auto r = uploadRgba(frame); !r) return std::unexpected(r.error());
+    uploaded_ = {frame.format, frame.width, frame.height, frame.colorimetry};
+    converted_ = true;
   } else {
     if (path == UploadPath::kPlanes) {
       if (auto r = uploadPlanes(frame); !r) return std::unexpected(r.error());
     }
-    if (auto r = convert(frame); !r) return std::unexpected(r.error());
+    uploaded_ = {frame.format, frame.width, frame.height, frame.colorimetry};
+    converted_ = false;
+    // A picture-only stream draws planar frames from their planes: no conversion pass now.
+    if (!(pictureOnly_ && drawableFromPlanes(frame.format))) {
+      if (auto r = convert(uploaded_); !r) return std::unexpected(r.error());
+    }
   }
   if (path != path_ || frame.format != format_ || !(frame.colorimetry == colorimetry_)) {
     path_ = path;
@@ -491,7 +567,8 @@ std::string StreamTexture::describe() const {
                      mirror_ ? ", mirrored" : "");
 }
 
-Result<void> StreamTexture::readPixels(Image& out) const {
+Result<void> StreamTexture::readPixels(Image& out) {
+  if (auto r = ensureConverted(); !r) return std::unexpected(r.error());
   const Gpu& g = *gpu_;
   if (out.width != g.width || out.height != g.height || out.channels != 4) out = Image::make(g.width, g.height, 4);
   glBindFramebuffer(GL_FRAMEBUFFER, g.fbo.id());

@@ -5,6 +5,7 @@
 /// plane as they come and converted to RGBA in a shader, once per new frame however many parts
 /// show it; and the Zoom picture (LAVA §7.1, §4.3), a stream drawn flat over the scene.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -27,6 +28,9 @@ enum class UploadPath : std::uint8_t {
 };
 
 std::string_view uploadPathName(UploadPath path);
+
+class PictureOverlay;
+struct PictureRect;
 
 /// \brief One stream's RGBA texture, registered in a TextureRegistry under the stream's name.
 ///
@@ -69,7 +73,21 @@ class StreamTexture {
   [[nodiscard]] bool dmabufImportOffered() const { return dmabufOffered_; }
 
   /// \brief Reads the RGBA texture back, top row first (tests and snapshots).
-  [[nodiscard]] Result<void> readPixels(Image& out) const;
+  [[nodiscard]] Result<void> readPixels(Image& out);
+
+  /// \brief For a stream shown only as a picture (the Zoom picture, never on a part): planar
+  /// frames (I420, YV12, NV12, NV21) are then not converted at update(), but drawn straight from
+  /// their planes by drawPicture(), one pass instead of two. readPixels() converts on demand;
+  /// view() keeps the last frame converted, so a picture-only stream is not for parts. Off by
+  /// default.
+  void setPictureOnly(bool pictureOnly);
+  [[nodiscard]] bool pictureOnly() const { return pictureOnly_; }
+  /// \brief Draws the frame shown into the bound framebuffer of `viewport` size at `rect`: from
+  /// its planes in one pass when it can (a picture-only stream, a planar frame, opaque), else
+  /// the RGBA texture through `overlay`. Nothing while the fallback shows.
+  void drawPicture(PictureOverlay& overlay, const PictureRect& rect, Size viewport, float opacity = 1.0f);
+  /// \brief Pictures drawn straight from the planes (the one-pass path), for tests and figures.
+  [[nodiscard]] std::uint64_t directPictures() const { return directPictures_; }
 
  private:
   struct Gpu;
@@ -78,7 +96,18 @@ class StreamTexture {
   Result<void> uploadPlanes(const Frame& frame);
   Result<void> importDmabuf(const Frame& frame);
   Result<void> uploadRgba(const Frame& frame);
-  Result<void> convert(const Frame& frame);
+  /// What the planes on the GPU hold: enough to convert or draw them after the frame is gone.
+  struct Uploaded {
+    PixelFormat format = PixelFormat::kUnknown;
+    std::uint32_t width = 0, height = 0;
+    Colorimetry colorimetry{};
+  };
+  Result<void> convert(const Uploaded& planes);
+  /// Runs the conversion program over the planes into the bound framebuffer: the whole of it
+  /// (`ndc` -1..1, into the target) or a picture rectangle (flipped: frames are top row first).
+  Result<void> drawPlanes(const Uploaded& planes, const std::array<float, 4>& ndc, bool flip);
+  /// The view with the target holding the current frame (converts a picture-only frame).
+  Result<void> ensureConverted();
 
   std::string name_;
   std::unique_ptr<Gpu> gpu_;
@@ -93,6 +122,10 @@ class StreamTexture {
   bool fallback_ = true;
   bool dmabufOffered_ = false;
   bool mirror_ = false;
+  bool pictureOnly_ = false;
+  bool converted_ = true;  // the target holds the current frame (false: only its planes do)
+  Uploaded uploaded_;
+  std::uint64_t directPictures_ = 0;
   float fallbackColor_[3] = {0.12f, 0.12f, 0.12f};
 };
 

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <memory>
 
+#include "render/gl.h"
 #include "render/output.h"
 #include "render/stream_texture.h"
 #include "render/texture_registry.h"
@@ -255,6 +256,108 @@ TEST_F(StreamTextures, DmabufImportWhereEglOffersIt) {
                     "frames are uploaded as planes instead";
   }
   GTEST_SKIP() << "EGL offers dmabuf import, but no dmabuf exporter (udmabuf, a camera) is available to this test";
+}
+
+// The Zoom picture drawn straight from the planes (a picture-only stream: one pass, no RGBA
+// texture in between) looks like the picture drawn through the converted texture, for every
+// planar layout, mirrored or not, at its own size and scaled; layouts it cannot draw that way,
+// and translucent pictures, take the texture path. Example failures: the picture upside down or
+// U and V swapped on the one-pass path; a picture-only stream whose texture is read back stale.
+class DirectPictures : public StreamTextures, public ::testing::WithParamInterface<LayoutCase> {
+ protected:
+  Image drawn(StreamTexture& stream, PictureOverlay& overlay, const PictureRect& rect) {
+    EXPECT_TRUE(output_->beginFrame());
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    stream.drawPicture(overlay, rect, output_->size());
+    Image image;
+    EXPECT_TRUE(output_->readBack(image));
+    return image;
+  }
+};
+
+TEST_P(DirectPictures, LookLikeThePictureThroughTheTexture) {
+  const LayoutCase& c = GetParam();
+  auto overlay = PictureOverlay::create();
+  ASSERT_TRUE(overlay) << overlay.error().describe();
+  auto direct = StreamTexture::create("direct");
+  ASSERT_TRUE(direct);
+  (*direct)->setPictureOnly(true);
+  for (const bool mirrored : {false, true}) {
+    SCOPED_TRACE(mirrored ? "mirrored" : "as is");
+    stream_->setMirror(mirrored);
+    (*direct)->setMirror(mirrored);
+    std::shared_ptr<FramePool> pool;
+    FrameRef frame = bandFrame(c.format, c.colorimetry, pool);
+    frame->sequence = mirrored ? 2 : 1;
+    ASSERT_TRUE(stream_->update(frame));
+    ASSERT_TRUE((*direct)->update(frame));
+    for (const PictureRect rect : {PictureRect{0, 16, 64, 32}, PictureRect{8, 4, 40, 52}}) {
+      const std::uint64_t before = (*direct)->directPictures();
+      const Image reference = drawn(*stream_, **overlay, rect);
+      const Image oneResult = drawn(**direct, **overlay, rect);
+      EXPECT_EQ((*direct)->directPictures(), before + 1) << "drawn from the planes";
+      if (rect.width == kWidth && rect.height == kHeight) {
+        // At its own size: texel by texel, the same picture.
+        const ImageDifference d = compareImages(oneResult, reference, 6);
+        EXPECT_LE(d.pixelsOverTolerance, 8u) << "max delta " << d.maxChannelDelta;
+      } else {
+        // Scaled, the planes are filtered before the conversion (the texture path filters after
+        // it): the edges of the bands blend differently; the middle of each band is the same.
+        for (int band = 0; band < 4; ++band) {
+          const auto bx = static_cast<std::uint32_t>(rect.x + rect.width * (static_cast<float>(band) + 0.5f) / 4);
+          const auto top = static_cast<std::uint32_t>(rect.y),
+                     bottom = static_cast<std::uint32_t>(rect.y + rect.height);
+          for (std::uint32_t by = top + 1; by + 1 < bottom; ++by) {
+            for (std::uint32_t ch = 0; ch < 3; ++ch) {
+              ASSERT_NEAR(oneResult.at(bx, by, ch), reference.at(bx, by, ch), 6) << "band " << band << " row " << by;
+            }
+          }
+        }
+      }
+      // The bands run left to right (right to left mirrored): red at the left edge as is.
+      const auto x = static_cast<std::uint32_t>(rect.x + 2), y = static_cast<std::uint32_t>(rect.y + rect.height / 2);
+      if (mirrored) {
+        EXPECT_LT(oneResult.at(x, y, 0), 200) << "mirrored: the left edge is not red";
+      } else {
+        EXPECT_GT(oneResult.at(x, y, 0), 200) << "the left edge is red";
+        EXPECT_LT(oneResult.at(x, y, 1), 60);
+      }
+    }
+  }
+  EXPECT_EQ((*direct)->conversions(), 2u) << "frames counted as shown";
+  // Read back, a picture-only stream converts on demand: the same texture as the other.
+  Image a, b;
+  ASSERT_TRUE(stream_->readPixels(a));
+  ASSERT_TRUE((*direct)->readPixels(b));
+  EXPECT_EQ(compareImages(a, b, 0).pixelsOverTolerance, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Planar, DirectPictures,
+    ::testing::Values(LayoutCase{PixelFormat::kI420, k709Limited}, LayoutCase{PixelFormat::kYv12, k601Limited},
+                      LayoutCase{PixelFormat::kNv12, k601Full}, LayoutCase{PixelFormat::kNv21, k601Limited}),
+    [](const ::testing::TestParamInfo<LayoutCase>& p) { return std::string(pixelFormatName(p.param.format)); });
+
+TEST_F(StreamTextures, PackedLayoutsAndTranslucentPicturesTakeTheTexturePath) {
+  auto overlay = PictureOverlay::create();
+  ASSERT_TRUE(overlay);
+  stream_->setPictureOnly(true);
+  std::shared_ptr<FramePool> pool;
+  FrameRef packed = bandFrame(PixelFormat::kYuyv, k601Limited, pool);
+  ASSERT_TRUE(stream_->update(packed));
+  ASSERT_TRUE(output_->beginFrame());
+  stream_->drawPicture(**overlay, {0, 0, 64, 64}, output_->size());
+  EXPECT_EQ(stream_->directPictures(), 0u) << "YUYV is converted, then drawn as a texture";
+  std::shared_ptr<FramePool> pool2;
+  FrameRef planar = bandFrame(PixelFormat::kI420, k601Limited, pool2);
+  planar->sequence = 7;
+  ASSERT_TRUE(stream_->update(planar));
+  stream_->drawPicture(**overlay, {0, 0, 64, 64}, output_->size(), 0.5f);
+  EXPECT_EQ(stream_->directPictures(), 0u) << "a translucent picture blends the texture";
+  Image image;
+  ASSERT_TRUE(output_->readBack(image));
+  EXPECT_GT(image.at(2, 32, 0), 60) << "the translucent picture was drawn";
 }
 
 }  // namespace
