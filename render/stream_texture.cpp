@@ -438,7 +438,8 @@ bool drawableFromPlanes(PixelFormat f) {
 void StreamTexture::setPictureOnly(bool pictureOnly) {
   if (pictureOnly == pictureOnly_) return;
   pictureOnly_ = pictureOnly;
-  if (!pictureOnly_ && !converted_) (void)ensureConverted();
+  if (pictureOnly_ || converted_) return;
+  if (auto r = ensureConverted(); !r) log::warn(kLogRender, "stream '{}': {}", name_, r.error().describe());
 }
 
 Result<void> StreamTexture::ensureConverted() {
@@ -481,7 +482,7 @@ void StreamTexture::drawPicture(PictureOverlay& overlay, const PictureRect& rect
   if (!converted_) {
     GLint bound = 0;
     glGetIntegerv(GL_FRAMEBUFFER_BINDING, &bound);
-    (void)ensureConverted();
+    if (auto r = ensureConverted(); !r) log::warn(kLogRender, "stream '{}': {}", name_, r.error().describe());
     glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(bound));
   }
   overlay.draw(view_, rect, viewport, opacity);
