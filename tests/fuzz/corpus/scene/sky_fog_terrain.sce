@@ -1,0 +1,7 @@
+skybox[cube.png]
+fog function[linear] start[0] end[100] color[255,255,255]
+fog function[exp] density[0.5]
+terrain height.pgm amplitude[0.25]
+mapmin[-100,-5,-100] mapmax[100,50,100]
+unknownkey[1,2,3]
+projection fov[170]
