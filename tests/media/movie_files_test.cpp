@@ -67,6 +67,8 @@ TEST_P(MovieFile, PlaysAsExpectedOrFailsClearly) {
   (*player)->play();
   Nanos t{0};
   const test::Playthrough run = test::playFor(**player, t, info->frameDuration, c.frames * 2 + 50);
+  ASSERT_FALSE(run.stalled) << "the player stalled: no frame for 10 s after frame "
+                            << (run.frames.empty() ? -1 : run.frames.back());
   ASSERT_TRUE(run.reachedEnd) << "did not reach the end";
   ASSERT_FALSE(run.frames.empty());
   EXPECT_EQ(run.frames.front(), 0);

@@ -5,7 +5,11 @@ namespace basalt::test {
 Playthrough playFor(media::MoviePlayer& player, Nanos& showTime, Nanos step, std::int64_t maxSteps) {
   Playthrough result;
   for (std::int64_t i = 0; i < maxSteps; ++i) {
-    player.waitForFrameDue(showTime, std::chrono::seconds(10));
+    if (!player.waitForFrameDue(showTime, std::chrono::seconds(10)) && player.state() != media::MovieState::kFailed &&
+        player.state() != media::MovieState::kEmpty) {
+      result.stalled = true;
+      break;
+    }
     FrameRef f = player.frameAt(showTime);
     if (f) result.frames.push_back(static_cast<std::int64_t>(f->sequence));
     ++result.showSteps;

@@ -17,6 +17,9 @@ struct Playthrough {
   std::vector<std::int64_t> frames;  ///< frame numbers shown, in order (one per new frame)
   std::int64_t showSteps = 0;        ///< show-clock steps taken
   bool reachedEnd = false;
+  /// The decoder delivered nothing due for the limit of a step (10 s) while playing: the
+  /// playthrough stopped there instead of waiting out every remaining step.
+  bool stalled = false;
 };
 
 /// \brief Plays from the current position with a show clock stepped `step` at a time from
