@@ -25,7 +25,7 @@ constexpr bool kSanitized = false;
 #endif
 
 constexpr std::array<int, 5> kSignals = {SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT};
-constexpr std::size_t kAltStackBytes = 64 * 1024;
+constexpr std::size_t kAltStackBytes = std::size_t{64} * 1024;
 constexpr int kMaxFrames = 64;
 
 const char* gProgram = "basalt";  // set once at install, read in the handler
