@@ -167,7 +167,7 @@ TEST_P(StreamColorimetry, ReachesTheFrames) {
   const ColorimetryCase& c = GetParam();
   const std::string launch = gstLaunchPath();
   if (launch.empty()) GTEST_SKIP() << "gst-launch-1.0 is not installed (gstreamer1.0-tools)";
-  const auto file = test::scratchDir("stream-colorimetry") / (std::string(c.name) + ".mkv");
+  const auto file = test::scratchDir(std::string("stream-colorimetry-") + c.name) / "clip.mkv";
   std::vector<std::string> argv{launch, "-q", "videotestsrc", "num-buffers=10", "!", c.caps, "!"};
   std::istringstream encoder(c.encoder);
   for (std::string word; encoder >> word;) argv.push_back(word);

@@ -22,7 +22,8 @@ class DisplayViewsTest : public RenderTest {
   void SetUp() override {
     RenderTest::SetUp();
     if (IsSkipped()) return;
-    folder_ = scratchDir("display_views");
+    // A folder per test: ctest runs the fixture's tests in parallel processes.
+    folder_ = scratchDir(std::string("display_views-") + testing::UnitTest::GetInstance()->current_test_info()->name());
     std::ofstream(folder_ / "display.obj") << cubeDisplayObj();
     std::ofstream(folder_ / "display.cave") << "# the test cube\nmodel display.obj\nfacet[5]\n";
   }
