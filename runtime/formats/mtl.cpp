@@ -197,17 +197,14 @@ class MtlParser {
     for (std::size_t i = 0; i < tokens.size();) {
       const std::string_view t = tokens[i].text;
       // A quoted name ("my texture -old.png", as Basalt writes names that would not read back
-      // otherwise) is one name: blanks and dashes inside are part of it. It ends at a quote
-      // followed by a blank or the end of the line.
+      // otherwise) is one name: blanks, dashes and quotes inside are part of it. It ends at the
+      // last quote on the line that is followed by a blank or the end of the line (a name may
+      // hold '" ' itself, and there is no escape).
       if (t.front() == '"') {
-        std::size_t close = tokens[i].offset + 1;
-        while (true) {
-          close = content.find('"', close);
-          if (close == std::string_view::npos || close + 1 >= content.size() || isBlank(content[close + 1]) ||
-              content[close + 1] == '\r') {
-            break;
-          }
-          ++close;
+        std::size_t close = std::string_view::npos;
+        for (std::size_t q = content.find('"', tokens[i].offset + 1); q != std::string_view::npos;
+             q = content.find('"', q + 1)) {
+          if (q + 1 >= content.size() || isBlank(content[q + 1]) || content[q + 1] == '\r') close = q;
         }
         if (close != std::string_view::npos) {
           if (nameStart == std::string_view::npos) nameStart = tokens[i].offset;
