@@ -215,17 +215,10 @@ Result<std::string> DisplayViews::calibrate(std::string_view name, std::string_v
     return fail(Errc::kInvalidArgument,
                 "the display geometry cannot change while the show plays: edit the cave file and reload");
   }
-  const formats::CaveGeometry& g = *v.cave.geometry;
-  const formats::CaveSettings& next = parsed->settings;
-  if (next.facet >= g.facets.size()) {
-    return fail(Errc::kInvalidArgument, fmt::format("facet {} does not exist; the display has facets 0 to {}",
-                                                    next.facet, g.facets.size() - 1));
+  if (auto problem = formats::caveSettingsProblem(parsed->settings, *v.cave.geometry)) {
+    return fail(Errc::kInvalidArgument, std::move(*problem));
   }
-  if (next.side >= g.facets[next.facet].corners.size()) {
-    return fail(Errc::kInvalidArgument, fmt::format("side {} does not exist; facet {} has sides 0 to {}", next.side,
-                                                    next.facet, g.facets[next.facet].corners.size() - 1));
-  }
-  v.cave.settings = next;
+  v.cave.settings = parsed->settings;
   log::info(kLogViews, "view '{}' calibrated: {}", v.spec.name, statements);
   if (save) {
     if (auto written = saveCalibration(*index); !written) return std::unexpected(written.error());

@@ -433,6 +433,15 @@ namespace {
 bool drawableFromPlanes(PixelFormat f) {
   return f == PixelFormat::kI420 || f == PixelFormat::kYv12 || f == PixelFormat::kNv12 || f == PixelFormat::kNv21;
 }
+
+/// A picture's rectangle (pixels from the top-left) in normalised device coordinates (y up):
+/// x0, y0, x1, y1, as the quad shader's uRect takes it. Sets the viewport to the whole output.
+std::array<float, 4> pictureNdc(const PictureRect& rect, Size viewport) {
+  const auto vw = static_cast<float>(viewport.width), vh = static_cast<float>(viewport.height);
+  glViewport(0, 0, static_cast<GLsizei>(viewport.width), static_cast<GLsizei>(viewport.height));
+  return {rect.x / vw * 2.0f - 1.0f, 1.0f - (rect.y + rect.height) / vh * 2.0f,
+          (rect.x + rect.width) / vw * 2.0f - 1.0f, 1.0f - rect.y / vh * 2.0f};
+}
 }  // namespace
 
 void StreamTexture::setPictureOnly(bool pictureOnly) {
@@ -453,11 +462,7 @@ void StreamTexture::drawPicture(PictureOverlay& overlay, const PictureRect& rect
     return;
   }
   if (pictureOnly_ && opacity >= 1.0f && drawableFromPlanes(uploaded_.format)) {
-    const auto vw = static_cast<float>(viewport.width), vh = static_cast<float>(viewport.height);
-    // Pixels from the top-left to normalised device coordinates (y up).
-    const float x0 = rect.x / vw * 2.0f - 1.0f, x1 = (rect.x + rect.width) / vw * 2.0f - 1.0f;
-    const float y1 = 1.0f - rect.y / vh * 2.0f, y0 = 1.0f - (rect.y + rect.height) / vh * 2.0f;
-    glViewport(0, 0, static_cast<GLsizei>(viewport.width), static_cast<GLsizei>(viewport.height));
+    const std::array<float, 4> ndc = pictureNdc(rect, viewport);
     // At the frame's own size the planes are read texel by texel (nearest: a plain load in a
     // software renderer); scaled, they are filtered as the texture path filters its texture.
     // (Imported dmabuf planes are filtered already.)
@@ -471,7 +476,7 @@ void StreamTexture::drawPicture(PictureOverlay& overlay, const PictureRect& rect
       glBindTexture(GL_TEXTURE_2D, 0);
     };
     if (scaled) filter(GL_LINEAR);
-    auto drawn = drawPlanes(uploaded_, {x0, y0, x1, y1}, true);
+    auto drawn = drawPlanes(uploaded_, ndc, true);
     if (scaled) filter(GL_NEAREST);
     if (drawn) {
       ++directPictures_;
@@ -613,11 +618,7 @@ Result<std::unique_ptr<PictureOverlay>> PictureOverlay::create() {
 
 void PictureOverlay::draw(const TextureView& texture, const PictureRect& rect, Size viewport, float opacity) {
   if (texture.id == 0 || viewport.width == 0 || viewport.height == 0) return;
-  const auto vw = static_cast<float>(viewport.width), vh = static_cast<float>(viewport.height);
-  // Pixels from the top-left to normalised device coordinates (y up).
-  const float x0 = rect.x / vw * 2.0f - 1.0f, x1 = (rect.x + rect.width) / vw * 2.0f - 1.0f;
-  const float y1 = 1.0f - rect.y / vh * 2.0f, y0 = 1.0f - (rect.y + rect.height) / vh * 2.0f;
-  glViewport(0, 0, static_cast<GLsizei>(viewport.width), static_cast<GLsizei>(viewport.height));
+  const std::array<float, 4> ndc = pictureNdc(rect, viewport);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   if (opacity < 1.0f) {
@@ -625,7 +626,7 @@ void PictureOverlay::draw(const TextureView& texture, const PictureRect& rect, S
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   }
   glUseProgram(gpu_->program.id());
-  glUniform4f(gpu_->rect, x0, y0, x1, y1);
+  glUniform4f(gpu_->rect, ndc[0], ndc[1], ndc[2], ndc[3]);
   glUniform1i(gpu_->flip, 1);
   glUniform1f(gpu_->opacity, opacity);
   glActiveTexture(GL_TEXTURE0);

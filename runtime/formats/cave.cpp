@@ -264,19 +264,10 @@ Result<LoadedCave> loadCave(const std::filesystem::path& path, const LoadedCave*
     cave.geometry = std::make_shared<const CaveGeometry>(std::move(*geometry));
   }
   if (cave.geometry) {
-    const auto& facets = cave.geometry->facets;
-    if (cave.settings.facet >= facets.size()) {
-      return fail(Errc::kInvalidArgument,
-                  fmt::format("facet {} does not exist: the geometry {} has facets 0 to {}", cave.settings.facet,
-                              cave.geometry->path.string(), facets.size() - 1),
-                  d.where(parsed->facetLine));
-    }
-    const std::size_t sides = facets[cave.settings.facet].corners.size();
-    if (cave.settings.side >= sides) {
-      return fail(Errc::kInvalidArgument,
-                  fmt::format("side {} does not exist: facet {} has sides 0 to {}", cave.settings.side,
-                              cave.settings.facet, sides - 1),
-                  d.where(parsed->sideLine ? parsed->sideLine : parsed->facetLine));
+    bool sideWrong = false;
+    if (auto problem = caveSettingsProblem(cave.settings, *cave.geometry, &sideWrong)) {
+      return fail(Errc::kInvalidArgument, std::move(*problem),
+                  d.where(sideWrong && parsed->sideLine ? parsed->sideLine : parsed->facetLine));
     }
   } else if (parsed->facetLine || parsed->sideLine) {
     warnings.push_back({path.string(),
@@ -285,6 +276,22 @@ Result<LoadedCave> loadCave(const std::filesystem::path& path, const LoadedCave*
   }
   cave.warnings = std::move(warnings);
   return cave;
+}
+
+std::optional<std::string> caveSettingsProblem(const CaveSettings& settings, const CaveGeometry& geometry,
+                                               bool* sideWrong) {
+  if (sideWrong) *sideWrong = false;
+  const auto& facets = geometry.facets;
+  if (settings.facet >= facets.size()) {
+    return fmt::format("facet {} does not exist: the geometry {} has facets 0 to {}", settings.facet,
+                       geometry.path.string(), facets.size() - 1);
+  }
+  const std::size_t sides = facets[settings.facet].corners.size();
+  if (settings.side >= sides) {
+    if (sideWrong) *sideWrong = true;
+    return fmt::format("side {} does not exist: facet {} has sides 0 to {}", settings.side, settings.facet, sides - 1);
+  }
+  return std::nullopt;
 }
 
 std::string formatCave(const CaveSettings& s) {

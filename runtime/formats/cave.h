@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -87,6 +88,12 @@ struct CaveParse {
 /// what it names). A named model is loaded and validated; the facet and side must exist on it.
 [[nodiscard]] Result<LoadedCave> loadCave(const std::filesystem::path& path, const LoadedCave* previous = nullptr,
                                           const LoadOptions& options = {});
+
+/// \brief Why `settings` do not fit `geometry` (a facet or a side that does not exist), or
+/// nothing when they do. `sideWrong`, when given, says whether it is the side (else the facet).
+/// What loading a cave file and calibrating a view live both check.
+std::optional<std::string> caveSettingsProblem(const CaveSettings& settings, const CaveGeometry& geometry,
+                                               bool* sideWrong = nullptr);
 
 /// \brief Cave-file text for `settings` (every setting, in the thesis' bracket form).
 std::string formatCave(const CaveSettings& settings);
