@@ -20,6 +20,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstring>
 #include <fstream>
 #include <thread>
 
@@ -38,20 +39,44 @@ namespace {
 
 using namespace std::chrono_literals;
 
+/// A folder of its own under /tmp for sockets: a socket's path must fit sun_path (107 bytes),
+/// which a build folder deep in a checkout does not always leave room for.
+class SocketDir {
+ public:
+  SocketDir() {
+    char name[] = "/tmp/basalt-sock-XXXXXX";
+    if (::mkdtemp(name)) path_ = name;
+  }
+  ~SocketDir() {
+    std::error_code ec;
+    if (!path_.empty()) std::filesystem::remove_all(path_, ec);
+  }
+  SocketDir(const SocketDir&) = delete;
+  SocketDir& operator=(const SocketDir&) = delete;
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
 /// A datagram socket the way systemd's notify and journal sockets are.
 class DatagramSocket {
  public:
   explicit DatagramSocket(std::filesystem::path path) : path_(std::move(path)) {
-    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     sockaddr_un address{};
+    if (path_.native().size() >= sizeof address.sun_path) {
+      ADD_FAILURE() << "the socket path " << path_ << " is longer than " << sizeof address.sun_path - 1 << " bytes";
+      return;
+    }
+    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     address.sun_family = AF_UNIX;
-    std::snprintf(address.sun_path, sizeof address.sun_path, "%s", path_.c_str());
+    std::memcpy(address.sun_path, path_.c_str(), path_.native().size() + 1);
     ::unlink(path_.c_str());
     bound_ = ::bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0;
   }
   ~DatagramSocket() {
-    ::close(fd_);
-    ::unlink(path_.c_str());
+    if (fd_ >= 0) ::close(fd_);
+    if (bound_) ::unlink(path_.c_str());
   }
   DatagramSocket(const DatagramSocket&) = delete;
   DatagramSocket& operator=(const DatagramSocket&) = delete;
@@ -104,7 +129,8 @@ resume = true
 struct ServiceManager {
   std::filesystem::path dir =
       test::scratchDir(std::string("supervision-") + testing::UnitTest::GetInstance()->current_test_info()->name());
-  DatagramSocket notify{dir / "notify.sock"};
+  SocketDir sockets;
+  DatagramSocket notify{sockets.path() / "notify.sock"};
   std::filesystem::path show = [this] {
     std::ofstream(dir / "show.toml") << kShow;
     return dir / "show.toml";
@@ -131,7 +157,7 @@ TEST(Supervision, ReadyStatusWatchdogReloadAndStop) {
   ASSERT_TRUE(manager.notify.bound());
   test::Process p = manager.start(400ms);
   std::vector<std::string> seen;
-  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s, &seen)) << p.outputSoFar();
+  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s, &seen)) << p.outputWithin(1s);
   std::string status;
   for (const auto& d : seen) status += d + "|";
   EXPECT_NE(status.find("STATUS=open, playing: 'Supervised' (1/1)"), std::string::npos) << status;
@@ -146,7 +172,7 @@ TEST(Supervision, ReadyStatusWatchdogReloadAndStop) {
 
   p.signal(SIGHUP);
   EXPECT_TRUE(manager.notify.waitFor("RELOADING=1", 5s)) << p.outputSoFar();
-  EXPECT_TRUE(manager.notify.waitFor("READY=1", 10s)) << p.outputSoFar();
+  EXPECT_TRUE(manager.notify.waitFor("READY=1", 10s)) << p.outputWithin(1s);
 
   p.signal(SIGTERM);
   EXPECT_TRUE(manager.notify.waitFor("STOPPING=1", 5s)) << p.outputSoFar();
@@ -172,7 +198,7 @@ TEST(Supervision, AHungShowIsKilledAndComesBackWhereItWas) {
   ServiceManager manager;
   ASSERT_TRUE(manager.notify.bound());
   test::Process first = manager.start(500ms);
-  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << first.outputSoFar();
+  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << first.outputWithin(1s);
   std::this_thread::sleep_for(3s);  // the state is saved every 2 s of show time
 
   // Hung on purpose: nothing of the process runs, so no ping comes.
@@ -186,7 +212,7 @@ TEST(Supervision, AHungShowIsKilledAndComesBackWhereItWas) {
 
   // Restart=always.
   test::Process second = manager.start(500ms);
-  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << second.outputSoFar();
+  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << second.outputWithin(1s);
   ASSERT_TRUE(second.waitForOutput("resuming 'Supervised' at ", 5s)) << second.outputSoFar();
   const std::string& out = second.outputSoFar();
   const auto at = out.find("resuming 'Supervised' at ") + 25;
@@ -199,7 +225,7 @@ TEST(Supervision, AHungShowIsKilledAndComesBackWhereItWas) {
   second.signal(SIGKILL);
   second.wait(10s);
   test::Process third = manager.start(500ms);
-  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << third.outputSoFar();
+  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << third.outputWithin(1s);
   ASSERT_TRUE(third.waitForOutput("resuming 'Supervised' at ", 5s)) << third.outputSoFar();
   const std::string& out3 = third.outputSoFar();
   const double later = std::stod(out3.substr(out3.find("resuming 'Supervised' at ") + 25));
@@ -214,7 +240,7 @@ TEST(Supervision, ACorruptStateFileIsIgnoredWithAWarning) {
   std::filesystem::create_directories(manager.dir / "state");
   {
     test::Process p = manager.start(2s);
-    ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << p.outputSoFar();
+    ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << p.outputWithin(1s);
     p.signal(SIGTERM);
     p.wait(20s);
   }
@@ -226,7 +252,7 @@ TEST(Supervision, ACorruptStateFileIsIgnoredWithAWarning) {
   }
   ASSERT_EQ(damaged, 1);
   test::Process p = manager.start(2s);
-  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << p.outputSoFar();
+  ASSERT_TRUE(manager.notify.waitFor("READY=1", 20s)) << p.outputWithin(1s);
   EXPECT_TRUE(p.waitForOutput("ignoring the saved state", 5s)) << p.outputSoFar();
   EXPECT_NE(p.outputSoFar().find("the show starts from the beginning"), std::string::npos) << p.outputSoFar();
   EXPECT_EQ(p.outputSoFar().find("resuming"), std::string::npos) << p.outputSoFar();
@@ -291,7 +317,8 @@ TEST(Supervision, PingsComeFromTheFrameLoop) {
   if (!output) GTEST_SKIP() << "no headless EGL here: " << output.error().describe();
   auto renderer = render::Renderer::create();
   ASSERT_TRUE(renderer);
-  DatagramSocket notify(test::scratchDir("supervision-inprocess") / "notify.sock");
+  SocketDir sockets;
+  DatagramSocket notify(sockets.path() / "notify.sock");
   ASSERT_TRUE(notify.bound());
   ::setenv("NOTIFY_SOCKET", notify.path().c_str(), 1);
   ::setenv("WATCHDOG_USEC", "200000", 1);

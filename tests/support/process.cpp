@@ -96,6 +96,14 @@ bool Process::waitForOutput(const std::string& needle, std::chrono::milliseconds
   return true;
 }
 
+const std::string& Process::outputWithin(std::chrono::milliseconds limit) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now());
+    if (left.count() <= 0 || !readSome(static_cast<int>(left.count()))) return output_;
+  }
+}
+
 ProcessResult Process::wait(std::chrono::milliseconds limit) {
   ProcessResult result;
   const auto end = std::chrono::steady_clock::now() + limit;

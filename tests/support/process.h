@@ -37,6 +37,9 @@ class Process {
   /// \brief Reads what output is available within `limit`; for waiting on a line.
   bool waitForOutput(const std::string& needle, std::chrono::milliseconds limit);
   [[nodiscard]] const std::string& outputSoFar() const { return output_; }
+  /// \brief Reads for `limit` (or until the output ends) and returns all output so far: for
+  /// failure messages of tests that waited on something else.
+  const std::string& outputWithin(std::chrono::milliseconds limit);
 
  private:
   Process(pid_t pid, int fd) : pid_(pid), fd_(fd) {}
