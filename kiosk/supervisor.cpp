@@ -8,8 +8,10 @@
 #include <systemd/sd-journal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 
 #include <fmt/format.h>
@@ -40,7 +42,14 @@ void Supervisor::notify(const std::string& message) {
   if (!notifying_) return;
   if (const int rc = sd_notify(0, message.c_str()); rc < 0) {
     static log::Once once;
-    if (once.first()) log::warn(kLogSupervision, "cannot notify the service manager: {}", std::strerror(-rc));
+    if (once.first()) {
+      const char* socket = std::getenv("NOTIFY_SOCKET");
+      log::warn(kLogSupervision,
+                "cannot notify the service manager at $NOTIFY_SOCKET={}: {}{}; the show goes on without "
+                "readiness or watchdog messages",
+                socket ? socket : "", std::strerror(-rc),
+                rc == -ENAMETOOLONG ? " (a socket path holds at most 107 bytes)" : "");
+    }
   }
 }
 

@@ -260,6 +260,24 @@ TEST(Supervision, ACorruptStateFileIsIgnoredWithAWarning) {
   EXPECT_EQ(p.wait(20s).exitCode, 0);
 }
 
+TEST(Supervision, ANotifySocketThatCannotBeReachedIsOneWarningAndTheShowGoesOn) {
+  REQUIRE_EGL();
+  const std::filesystem::path dir = test::scratchDir("supervision-unreachable");
+  std::ofstream(dir / "show.toml") << kShow;
+  const std::string tooLong = "/tmp/" + std::string(120, 'n');
+  for (const std::string& socket : {tooLong, std::string("/tmp/basalt-no-such-notify-socket")}) {
+    const auto r = test::run({(test::binaryDir() / "basalt").string(), "run", (dir / "show.toml").string(), "--frames",
+                              "20", "--state-dir", (dir / "state").string()},
+                             {{"NOTIFY_SOCKET", socket}, {"WATCHDOG_USEC", "100000"}}, 60s);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    const std::string warning = "cannot notify the service manager at $NOTIFY_SOCKET=" + socket;
+    const auto first = r.output.find(warning);
+    ASSERT_NE(first, std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find(warning, first + 1), std::string::npos) << "one warning, not one a frame: " << r.output;
+    EXPECT_EQ(r.output.find("107 bytes") != std::string::npos, socket == tooLong) << r.output;
+  }
+}
+
 TEST(Supervision, UnderARealSystemdUserManager) {
   REQUIRE_EGL();
   if (::access("/usr/bin/systemd-run", X_OK) != 0) GTEST_SKIP() << "systemd-run is not installed";
