@@ -129,7 +129,7 @@ void setSampling(GLenum filter) {
 /// The conversion program for one layout.
 struct ConversionProgram {
   gl::Program program;
-  GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1, chromaScale = -1, mirrorWidth = -1;
+  GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1, flipX = -1, chromaScale = -1, mirrorWidth = -1;
 };
 
 /// yuv.frag with LAYOUT defined: one program per layout, so no pixel runs a branch.
@@ -149,6 +149,7 @@ Result<ConversionProgram> buildConversion(int layout) {
   c.bias = glGetUniformLocation(p, "uBias");
   c.rect = glGetUniformLocation(p, "uRect");
   c.flip = glGetUniformLocation(p, "uFlipY");
+  c.flipX = glGetUniformLocation(p, "uFlipX");
   c.chromaScale = glGetUniformLocation(p, "uChromaScale");
   c.mirrorWidth = glGetUniformLocation(p, "uMirrorWidth");
   glUseProgram(p);
@@ -405,7 +406,9 @@ Result<void> StreamTexture::drawPlanes(const Uploaded& planes, const std::array<
     glUniform2f(c.chromaScale, static_cast<float>(planes.width) / static_cast<float>(2 * cw),
                 static_cast<float>(planes.height) / static_cast<float>(2 * ch));
   }
-  // Mirrored: the target's left column is the frame's right one.
+  // Mirrored: the target's left column is the frame's right one (the quad mirrors what is
+  // sampled through coordinates, the shader what is fetched by position).
+  glUniform1i(c.flipX, mirror_ ? 1 : 0);
   glUniform1i(c.mirrorWidth, mirror_ ? static_cast<GLint>(planes.width) : 0);
   // YV12 stores V before U: bind the planes so that unit 1 is always U.
   const bool swapUv = planes.format == PixelFormat::kYv12;

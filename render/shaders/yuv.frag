@@ -38,12 +38,13 @@ vec3 toRgb(vec3 yuv) { return yuv.x * uYCoef + yuv.y * uUCoef + yuv.z * uVCoef +
 void main() {
   // The target has the frame's size: every sample is a texel fetch (no filtering), chroma at
   // half resolution: 4:2:0 chroma sited with its top-left luma sample.
-  ivec2 px = ivec2(gl_FragCoord.xy);
+  // Layouts read through texture() are mirrored by the quad (uFlipX); those fetched by the
+  // fragment's position here.
   vec2 uv = vUv;
-  if (uMirrorWidth > 0) {
-    px.x = uMirrorWidth - 1 - px.x;
-    uv.x = 1.0 - uv.x;  // texel centres map onto texel centres
-  }
+#if LAYOUT <= LAYOUT_GRAY || LAYOUT >= LAYOUT_YUYV
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  if (uMirrorWidth > 0) px.x = uMirrorWidth - 1 - px.x;
+#endif
 #if LAYOUT == LAYOUT_RGBA
   fragColor = vec4(texelFetch(uPlane0, px, 0).rgb, 1.0);
 #elif LAYOUT == LAYOUT_BGRA
