@@ -509,6 +509,7 @@ class Reader {
     if (const toml::table* t = table(root, "media", "")) readMedia(*t);
     readBindings(root);
     if (const toml::table* t = table(root, "textures", "")) readTextures(*t);
+    checkMediaShown();
     if (const toml::table* t = table(root, "kiosk", "")) readKiosk(*t);
     if (const toml::table* t = table(root, "status", "")) readStatus(*t);
 
@@ -1298,6 +1299,20 @@ class Reader {
         }
       }
       manifest_.media.push_back(std::move(m));
+    }
+  }
+
+  /// A movie or camera that no texture shows is never played or opened: say so.
+  void checkMediaShown() {
+    for (const MediaSpec& m : manifest_.media) {
+      if (m.kind == MediaKind::kImage) continue;
+      const bool shown =
+          std::ranges::any_of(manifest_.textures, [&](const TextureSpec& t) { return t.source == m.name; });
+      if (shown) continue;
+      warning(m.line, fmt::format("media.{}: no texture shows it, so the {} is never {}; add [textures.NAME] with "
+                                  "source = \"{}\"",
+                                  m.name, m.kind == MediaKind::kMovie ? "movie" : "camera",
+                                  m.kind == MediaKind::kMovie ? "played" : "opened", m.name));
     }
   }
 

@@ -74,6 +74,7 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
       }
     }
     t.live = false;
+    t.since = wall;
   }
   ++showGeneration_;
   // Images not read yet (start-up) are read once the first frame is on screen, so that decoding
@@ -446,16 +447,23 @@ void ShowDirector::updateStreams(Nanos now) {
   for (LoadedTexture& t : show_->textures) {
     if (!t.stream) continue;
     const bool live = t.stream->update(now, context_.renderer.textures(), t.name);
+    const std::optional<SourceState> device = t.stream->deviceState();
+    if (live == t.live && device == t.deviceState) continue;
+    t.deviceState = device;
+    t.since = context_.clock.wallNow();
+    changed = true;
     if (live == t.live) continue;
     t.live = live;
-    changed = true;
     if (!live && t.image) {
       if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
         log::warn(kLogDirector, "texture '{}': {}", t.name, r.error().describe());
       }
     }
   }
-  if (changed) publishStreams();
+  if (changed) {
+    publishStreams();
+    publishDevices();  // a camera's row follows the stream that shows it
+  }
 }
 
 void ShowDirector::saveState(Nanos now) {
@@ -561,6 +569,7 @@ void ShowDirector::publishShow() {
 
 void ShowDirector::publishDevices() {
   std::vector<DeviceStatus> out;
+  const WallTime wall = context_.clock.wallNow();
   for (const DeviceSlot& slot : show_->devices) {
     DeviceStatus d;
     d.name = slot.spec.name;
@@ -569,9 +578,35 @@ void ShowDirector::publishDevices() {
     d.state = slot.dialBox ? std::string(devices::deviceStateName(slot.dialBox->state())) : "absent";
     d.message = slot.message.empty() && slot.dialBox ? slot.dialBox->info().name : slot.message;
     d.since = slot.since;
+    if (slot.spec.kind == DeviceKind::kCamera && !slot.dialBox) cameraRow(d, slot);
+    if (d.since == WallTime{}) d.since = wall;
     out.push_back(std::move(d));
   }
   context_.board.publishDevices(std::move(out));
+}
+
+void ShowDirector::cameraRow(DeviceStatus& d, const DeviceSlot& slot) const {
+  // A camera is opened by the texture stream of the media that shows it: its row is that
+  // stream's state.
+  for (const LoadedTexture& t : show_->textures) {
+    const MediaSpec* media = t.source.empty() ? nullptr : show_->manifest.findMedia(t.source);
+    if (!media || media->kind != MediaKind::kCamera || media->device != slot.spec.name) continue;
+    if (t.deviceState) {
+      d.state =
+          *t.deviceState == SourceState::kLive ? "live" : (*t.deviceState == SourceState::kLost ? "lost" : "absent");
+    } else {
+      d.state = t.live ? "live" : (t.stream ? "lost" : "absent");
+    }
+    d.message = t.stream ? fmt::format("shown by texture '{}': {}", t.name, t.stream->describe())
+                         : fmt::format("texture '{}': {}", t.name, t.streamState);
+    d.since = t.since;
+    return;
+  }
+  if (!slot.unavailable.starts_with("a camera")) return;  // this build cannot open it: absent, saying why
+  d.state = "idle";
+  d.message =
+      "no texture shows it (a [textures.NAME] with source = a camera [media] naming it); a LAVA script's "
+      "video texture opens it itself";
 }
 
 void ShowDirector::publishStreams() {
@@ -585,9 +620,12 @@ void ShowDirector::publishStreams() {
     s.name = t.source;
     s.kind = std::string(mediaKindName(media->kind));
     s.state = t.live ? "playing" : (t.stream ? "waiting" : "absent");
+    // A camera that is gone while its texture shows the on_loss picture is not playing.
+    if (t.deviceState == SourceState::kLost) s.state = "lost";
+    if (t.deviceState == SourceState::kWaiting) s.state = "waiting";
     s.message = t.stream ? t.stream->describe() : t.streamState;
     if (!t.live) s.message += t.image ? "; showing the fallback image" : "; showing black";
-    s.since = wall;
+    s.since = t.since == WallTime{} ? wall : t.since;
     out.push_back(std::move(s));
   }
   context_.board.publishStreams(std::move(out));

@@ -98,6 +98,8 @@ class ShowDirector final : public FrameParticipant {
   void publishShow();
   void publishDevices();
   void publishStreams();
+  /// A camera's status row: the state of the stream that shows it.
+  void cameraRow(DeviceStatus& d, const DeviceSlot& slot) const;
   /// Removes the textures the last item put in the registry, unless `nextKey` is that same item.
   void releaseItemTextures(const std::string& nextKey);
 

@@ -28,6 +28,7 @@
 #include "render/texture_registry.h"
 #include "runtime/bindings.h"
 #include "runtime/clock.h"
+#include "runtime/frame_queue.h"
 #include "runtime/image.h"
 
 namespace basalt::kiosk {
@@ -43,6 +44,9 @@ class TextureStream {
   virtual bool update(Nanos showTime, render::TextureRegistry& textures, const std::string& name) = 0;
   /// \brief One line for the status page: state and why.
   [[nodiscard]] virtual std::string describe() const = 0;
+  /// \brief A camera's own state as of the last update() (it can be lost while the texture
+  /// still shows something: its on_loss picture); none for streams without a device.
+  [[nodiscard]] virtual std::optional<SourceState> deviceState() const { return std::nullopt; }
 };
 
 using StreamFactory = std::function<Result<std::unique_ptr<TextureStream>>(const MediaSpec& media, const Manifest& show,
@@ -74,12 +78,14 @@ struct DeviceSlot {
 /// \brief One named texture of a show.
 struct LoadedTexture {
   std::string name;
-  std::string source;                     ///< the media it shows, "" for a plain image
-  std::filesystem::path imageFile;        ///< the image to show, or the fallback for a stream
-  std::optional<Image> image;             ///< imageFile, once read
-  std::unique_ptr<TextureStream> stream;  ///< movies and cameras
-  std::string streamState;                ///< why there is no stream, when there is none
-  bool live = false;                      ///< kept by the director
+  std::string source;                      ///< the media it shows, "" for a plain image
+  std::filesystem::path imageFile;         ///< the image to show, or the fallback for a stream
+  std::optional<Image> image;              ///< imageFile, once read
+  std::unique_ptr<TextureStream> stream;   ///< movies and cameras
+  std::string streamState;                 ///< why there is no stream, when there is none
+  bool live = false;                       ///< kept by the director
+  std::optional<SourceState> deviceState;  ///< the stream's deviceState() at the last update
+  WallTime since{};                        ///< when `live` or `deviceState` last changed (kept by the director)
 };
 
 /// \brief Everything a manifest needs to play.

@@ -73,7 +73,8 @@ std::string jsonString(std::string_view text) {
 
 std::string_view overallState(const StatusSnapshot& s) {
   for (const DeviceStatus& d : s.devices) {
-    if (d.state != "live") return "degraded";
+    // "idle": a camera no texture shows (a script may open it); nothing is wrong with it.
+    if (d.state != "live" && d.state != "idle") return "degraded";
   }
   for (const StreamStatus& st : s.streams) {
     if (st.state != "playing") return "degraded";

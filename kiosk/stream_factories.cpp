@@ -241,7 +241,8 @@ class CameraStream final : public TextureStream {
     // A camera that cannot flip in the device is mirrored by its texture.
     texture_->setMirror(stream_->mirrorInRenderer());
     const FrameRef frame = stream_->frameAt(showTime);
-    if (stream_->health().state != SourceState::kLive) return showLoss(textures);
+    state_ = stream_->health().state;
+    if (state_ != SourceState::kLive) return showLoss(textures);
     auto changed = texture_->update(frame);
     if (!changed) {
       log::warn(kLogStreams, "camera '{}': {}", media_, changed.error().describe());
@@ -309,6 +310,8 @@ class CameraStream final : public TextureStream {
     return false;
   }
 
+  [[nodiscard]] std::optional<SourceState> deviceState() const override { return state_; }
+
   [[nodiscard]] std::string describe() const override {
     for (const devices::DeviceStatus& s : manager_.status()) {
       if (s.name != name_) continue;
@@ -328,6 +331,7 @@ class CameraStream final : public TextureStream {
   CameraLoss onLoss_;
   std::array<std::uint8_t, 3> lossColour_;
   bool showingLoss_ = false;  // the loss picture is on the texture
+  SourceState state_ = SourceState::kWaiting;
   std::shared_ptr<FramePool> patternPool_;
   std::uint64_t patternSequence_ = 0;
   const Clock& clock_;

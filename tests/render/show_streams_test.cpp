@@ -421,9 +421,24 @@ TEST(ShowStreams, ALostCameraShowsItsOnLossColourAndComesBack) {
   EXPECT_TRUE(camera->live) << "the colour is what the texture shows: " << camera->stream->describe();
   EXPECT_TRUE(says(*camera, "showing #ff8000")) << camera->stream->describe();
   EXPECT_GT(orangePixels(h.lastFrame()), 50u) << "the sculpture shows the on_loss colour";
+  // The status says the camera is lost, though its texture shows something.
+  {
+    const StatusSnapshot status = h.board().snapshot(h.clock().wallNow());
+    ASSERT_EQ(status.devices.size(), 1u);
+    EXPECT_EQ(status.devices[0].state, "lost") << status.devices[0].message;
+    EXPECT_NE(status.devices[0].message.find("shown by texture 'camera.png': camera 'camera'"), std::string::npos)
+        << status.devices[0].message;
+    ASSERT_EQ(status.streams.size(), 1u);
+    EXPECT_EQ(status.streams[0].state, "lost") << status.streams[0].message;
+  }
   ASSERT_TRUE(runUntil(h, [&] { return !says(*camera, "showing"); })) << camera->stream->describe();
   h.run(2);
   EXPECT_TRUE(camera->live);
+  {
+    const StatusSnapshot status = h.board().snapshot(h.clock().wallNow());
+    EXPECT_EQ(status.devices[0].state, "live") << status.devices[0].message;
+    EXPECT_EQ(status.streams[0].state, "playing") << status.streams[0].message;
+  }
   EXPECT_EQ(orangePixels(h.lastFrame()), 0u) << "the live picture replaced the colour";
 }
 

@@ -47,6 +47,18 @@ kind = "dial_box"
 backend = "hid"
 match = { usb = "077d:0410" }
 
+[devices.cam]
+kind = "camera"
+backend = "synthetic"
+size = "64x48"
+
+[media.live]
+kind = "camera"
+device = "cam"
+
+[textures.camera]
+source = "live"
+
 [[kiosk.playlist]]
 name = "first"
 entry = "default"
@@ -103,8 +115,7 @@ TEST_F(StatusServer, HealthReportsTheShowItsFramesAndItsDevices) {
   EXPECT_NE(h.body.find("\"frames\": {\n    \"total\": "), std::string::npos) << h.body;
   EXPECT_NE(h.body.find("\"last_errors\": ["), std::string::npos) << h.body;
   EXPECT_NE(h.body.find("\"uptime_seconds\": "), std::string::npos) << h.body;
-  // Each device says since when it is in its state (ISO 8601), frames have a rate, and the
-  // streams are listed (none in this show).
+  // Each device says since when it is in its state (ISO 8601), and frames have a rate.
   EXPECT_TRUE(std::regex_search(
       h.body,
       std::regex(R"re("name": "dials", [^}]*"state": "live", "since": "[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:.]+)re")))
@@ -116,7 +127,14 @@ TEST_F(StatusServer, HealthReportsTheShowItsFramesAndItsDevices) {
   std::smatch rate;
   ASSERT_TRUE(std::regex_search(h.body, rate, std::regex(R"re("per_second": ([0-9.]+))re"))) << h.body;
   EXPECT_GT(std::stod(rate[1]), 0.0) << h.body;
-  EXPECT_NE(h.body.find("\"streams\": []"), std::string::npos) << h.body;
+  // The camera's stream plays, and the camera's row says so (its state is its stream's).
+  EXPECT_NE(h.body.find("\"streams\": [\n    {\"name\": \"live\", \"kind\": \"camera\", \"state\": \"playing\""),
+            std::string::npos)
+      << h.body;
+  EXPECT_NE(h.body.find("{\"name\": \"cam\", \"kind\": \"camera\", \"backend\": \"synthetic\", \"state\": \"live\""),
+            std::string::npos)
+      << h.body;
+  EXPECT_NE(h.body.find("shown by texture 'camera': "), std::string::npos) << h.body;
 }
 
 TEST_F(StatusServer, MetricsAreValidPrometheusText) {
@@ -402,6 +420,15 @@ TEST_F(StatusServer, PageRendersInABrowser) {
   EXPECT_NE(dom.output.find("<td>dials</td><td class=\"live\">live</td>"), std::string::npos) << dom.output;
   EXPECT_NE(dom.output.find("<td>knob</td><td class=\"absent\">absent</td>"), std::string::npos) << dom.output;
   EXPECT_NE(dom.output.find("open, playing: 'first' (1/2)"), std::string::npos) << dom.output;
+  EXPECT_NE(dom.output.find("<td>cam</td><td class=\"live\">live</td>"), std::string::npos) << dom.output;
+  EXPECT_NE(dom.output.find("<td>live</td><td class=\"playing\">playing</td>"), std::string::npos) << dom.output;
+  // The log tail, newest last.
+  const auto log = dom.output.find("<div id=\"log\">");
+  ASSERT_NE(log, std::string::npos) << dom.output;
+  const auto logEnd = dom.output.find("</div>", log);
+  const std::string tail = dom.output.substr(log, logEnd - log);
+  EXPECT_NE(tail.find("info kiosk: first frame on headless 160x120"), std::string::npos) << tail;
+  EXPECT_NE(tail.find("warning kiosk: device 'knob' (hid): no hid 077d:0410 is plugged in"), std::string::npos) << tail;
 
   // And what a phone's screen shows: the header, the amber "degraded" badge, and the live
   // thumbnail with the cube's colours in it.

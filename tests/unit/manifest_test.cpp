@@ -356,6 +356,25 @@ TEST(ManifestErrors, DevicesAreCoherent) {
   EXPECT_EQ(ok.manifest->devices[0].trace, fs::canonical(f.dir / "site.trace"));
 }
 
+TEST(ManifestErrors, AMovieOrCameraNoTextureShowsIsAWarning) {
+  ShowFolder f("unshown-media");
+  const auto r = f.read(
+      "[devices.cam]\nkind = \"camera\"\nbackend = \"synthetic\"\n"    // 1-3
+      "[media.live]\nkind = \"camera\"\ndevice = \"cam\"\n"            // 4-6
+      "[media.loop]\nkind = \"movie\"\nfile = \"clips/loop.webm\"\n"   // 7-9
+      "[media.card]\nkind = \"image\"\nfile = \"offline.png\"\n"       // 10-12
+      "[media.shown]\nkind = \"movie\"\nfile = \"clips/loop.webm\"\n"  // 13-15
+      "[textures.wall]\nsource = \"shown\"\nfallback = \"offline.png\"\n");
+  ASSERT_TRUE(r.manifest) << "warnings only: " << r.text;
+  EXPECT_TRUE(hasWarning(r, 4, "media.live: no texture shows it, so the camera is never opened")) << r.text;
+  EXPECT_TRUE(hasWarning(r, 7,
+                         "media.loop: no texture shows it, so the movie is never played; add [textures.NAME] "
+                         "with source = \"loop\""))
+      << r.text;
+  EXPECT_EQ(r.text.find("media.card"), std::string::npos) << "an image shown by nothing is harmless: " << r.text;
+  EXPECT_EQ(r.text.find("media.shown"), std::string::npos) << r.text;
+}
+
 TEST(ManifestErrors, SyntheticScriptsAreChecked) {
   ShowFolder f("synthetic");
   const auto r = f.read(
