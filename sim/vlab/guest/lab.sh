@@ -122,6 +122,14 @@ else
   fixture_fail uhid "modprobe uhid failed or /dev/uhid did not appear"
 fi
 
+# ---- evdev and uinput: keyboards and mice made by the tests themselves ----------------------
+if load evdev && load uinput && wait_for 2 test -c /dev/uinput; then
+  setenv BASALT_VLAB_UINPUT /dev/uinput
+  fixture_ok uinput "/dev/uinput (evdev nodes under /dev/input)"
+else
+  fixture_fail uinput "modprobe evdev/uinput failed or /dev/uinput did not appear: $(tail -1 "$hr/modprobe.log")"
+fi
+
 # ---- DRM: virtio-gpu (qemu -device virtio-gpu-pci) -----------------------------------------
 load virtio_gpu
 drm=
