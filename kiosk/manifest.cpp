@@ -501,7 +501,8 @@ class Reader {
     manifest_.name = manifest_.folder.filename().string();
     manifest_.entry = {EntryKind::kBuiltinDefault, "default", {}, 0};
 
-    checkKeys(root, "", {"show", "output", "views", "media", "devices", "bindings", "textures", "kiosk", "status"});
+    checkKeys(root, "",
+              {"show", "output", "views", "media", "devices", "bindings", "textures", "kiosk", "status", "input"});
     if (const toml::table* t = table(root, "show", "")) readShow(*t);
     if (const toml::table* t = table(root, "output", "")) readOutput(*t);
     readViews(root);
@@ -512,6 +513,7 @@ class Reader {
     checkMediaShown();
     if (const toml::table* t = table(root, "kiosk", "")) readKiosk(*t);
     if (const toml::table* t = table(root, "status", "")) readStatus(*t);
+    if (const toml::table* t = table(root, "input", "")) readInput(*t);
 
     // By line, keeping the order of problems found on the same line.
     std::vector<std::size_t> order(diagsOwn_.size());
@@ -1739,6 +1741,43 @@ class Reader {
       }
       day.note = string(*t, "note", path).value_or("");
       manifest_.kiosk.schedule.exceptions.push_back(std::move(day));
+    }
+  }
+
+  // ---- [input] ----
+  void readInput(const toml::table& t) {
+    InputSpec& in = manifest_.input;
+    in.line = lineOf(t);
+    checkKeys(t, "input", {"evdev", "keyboards", "pointers", "names"});
+    if (auto mode = choice<EvdevMode>(t, "evdev", "input",
+                                      {{"auto", EvdevMode::kAuto}, {"on", EvdevMode::kOn}, {"off", EvdevMode::kOff}})) {
+      in.evdev = *mode;
+    }
+    if (auto keyboards = boolean(t, "keyboards", "input")) in.keyboards = *keyboards;
+    if (auto pointers = boolean(t, "pointers", "input")) in.pointers = *pointers;
+    if (const toml::node* names = t.get("names")) {
+      const toml::array* a = names->as_array();
+      if (!a) {
+        error(lineOf(*names), "input.names: must be an array of device names, e.g. [\"Dell KB216\"]");
+      } else {
+        for (const toml::node& item : *a) {
+          const auto* name = item.as_string();
+          if (!name || name->get().empty()) {
+            error(lineOf(item), "input.names: each entry must be a device name (a non-empty string)");
+          } else {
+            in.names.push_back(name->get());
+          }
+        }
+      }
+    }
+    if (!in.keyboards && !in.pointers && in.evdev != EvdevMode::kOff) {
+      warning(in.line,
+              "input: keyboards and pointers are both false: no keyboard or mouse is read (say evdev = "
+              "\"off\" instead)");
+    }
+    if (in.evdev == EvdevMode::kOn && manifest_.output.kind == OutputKind::kWindow) {
+      warning(t.get("evdev") ? lineOf(*t.get("evdev")) : in.line,
+              "input.evdev: 'on' with the window output reads every key twice (the window delivers them too)");
     }
   }
 

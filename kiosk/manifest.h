@@ -310,6 +310,18 @@ struct StatusSpec {
   [[nodiscard]] bool loopbackOnly() const;
 };
 
+/// \brief `[input]`: keyboards and mice read from the kernel (evdev) when no window delivers
+/// them. "auto": with the KMS output only (a window has its own; headless has no visitor).
+enum class EvdevMode : std::uint8_t { kAuto, kOn, kOff };
+
+struct InputSpec {
+  EvdevMode evdev = EvdevMode::kAuto;
+  bool keyboards = true;           ///< read keyboards and numeric pads
+  bool pointers = true;            ///< read mice, trackballs and touchpads
+  std::vector<std::string> names;  ///< only devices whose name contains one of these; empty: all
+  int line = 0;
+};
+
 /// \brief A whole show manifest, validated.
 struct Manifest {
   std::filesystem::path file;    ///< absolute path of show.toml
@@ -325,6 +337,7 @@ struct Manifest {
   std::vector<TextureSpec> textures;
   KioskSpec kiosk;
   StatusSpec status;
+  InputSpec input;
 
   /// \brief A manifest for the built-in default show: no file, every default.
   static Manifest builtinDefault();

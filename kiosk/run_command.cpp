@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "devices/evdev/evdev_input.h"
 #include "kiosk/commands.h"
 #include "kiosk/device_wiring.h"
 #include "kiosk/display_views.h"
@@ -542,6 +543,24 @@ int runShow(const RunOptions& options) {
   ShowDirector director(
       DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps});
   director.install(std::move(*loaded), clock.now(), resume);
+  // Keyboards and mice where no window delivers them (KMS): read from evdev on a thread of their
+  // own, taken by the director each frame the way a window's keys are.
+  std::unique_ptr<devices::EvdevInput> keyboardsAndMice;
+  const EvdevMode evdevMode = manifest.input.evdev;
+  if (evdevMode == EvdevMode::kOn || (evdevMode == EvdevMode::kAuto && (*output)->kind() == "kms")) {
+    devices::EvdevOptions evdevOptions;
+    evdevOptions.keyboards = manifest.input.keyboards;
+    evdevOptions.pointers = manifest.input.pointers;
+    evdevOptions.names = manifest.input.names;
+    auto made = devices::EvdevInput::create(clock, std::move(evdevOptions), [eventLoop] { eventLoop->wake(); });
+    if (made) {
+      keyboardsAndMice = std::move(*made);
+      keyboardsAndMice->start();
+      director.setKeyboardsAndMice(keyboardsAndMice.get());
+    } else {
+      log::warn(kLogRun, "{}; keyboards and mice are not read", made.error().describe());
+    }
+  }
   if (script) show = script::startupShow();  // a script starts from LAVA's start-up state
 
   stopTarget = &frameLoop;

@@ -354,7 +354,7 @@ void ShowDirector::applyInput(Nanos until) {
 
 void ShowDirector::applyOutputInput(Nanos now) {
   std::array<Event, 64> input;
-  while (const std::size_t n = context_.output.takeInput(input)) {
+  const auto apply = [&](std::size_t n) {
     for (std::size_t i = 0; i < n; ++i) {
       Event& e = input[i];
       e.time = now;
@@ -370,7 +370,17 @@ void ShowDirector::applyOutputInput(Nanos now) {
       if (e.kind == EventKind::kPointerMotion && !pointerHeld_) continue;
       navigator_.apply(e, context_.show);
     }
+  };
+  while (const std::size_t n = context_.output.takeInput(input)) {
+    apply(n);
     if (n < input.size()) break;
+  }
+  // Keyboards and mice of a KMS kiosk (evdev): the same way as the window's.
+  if (keyboardsAndMice_) {
+    while (const std::size_t n = keyboardsAndMice_->takeInput(input)) {
+      apply(n);
+      if (n < input.size()) break;
+    }
   }
   if (lastNavigate_.count() >= 0 && now > lastNavigate_) {
     navigator_.advance(std::chrono::duration<double>(now - lastNavigate_).count(), context_.show);

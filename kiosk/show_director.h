@@ -15,6 +15,7 @@
 #include <string>
 #include <thread>
 
+#include "devices/evdev/evdev_input.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/kiosk_policy.h"
 #include "kiosk/show_loader.h"
@@ -66,6 +67,9 @@ class ShowDirector final : public FrameParticipant {
   /// \brief The show's views, for the calibration control (null: no `[[views]]`). Borrowed:
   /// they must outlive the director's frames.
   void setViews(DisplayViews* views) { views_ = views; }
+  /// \brief Keyboards and mice read from evdev (a KMS output has no window to deliver them):
+  /// their events go where the window's go. Borrowed; null: none.
+  void setKeyboardsAndMice(devices::EvdevInput* input) { keyboardsAndMice_ = input; }
 
   Result<void> beforeDraw(const FrameContext& frame) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
@@ -87,8 +91,8 @@ class ShowDirector final : public FrameParticipant {
   void handleControls(const FrameContext& frame);
   void serviceDevices(Nanos now);
   void applyInput(Nanos until);
-  /// Keys and pointer from the output: activity for the kiosk, the facet views' calibration
-  /// keys (thesis Appendix B), then walking the viewer (Navigator): held keys move it per frame,
+  /// Keys and pointer from the output's window and from evdev keyboards and mice: activity for the kiosk, the facet
+  /// views' calibration keys (thesis Appendix B), then walking the viewer (Navigator): held keys move it per frame,
   /// dragging with a button held turns it.
   void applyOutputInput(Nanos now);
   void advanceShuttles(Nanos now);
@@ -105,6 +109,7 @@ class ShowDirector final : public FrameParticipant {
 
   DirectorContext context_;
   DisplayViews* views_ = nullptr;
+  devices::EvdevInput* keyboardsAndMice_ = nullptr;
   std::unique_ptr<LoadedShow> show_;
   std::unique_ptr<KioskPolicy> policy_;
   std::shared_ptr<const Schedule> scheduleForStatus_;

@@ -762,5 +762,34 @@ TEST(ManifestDevices, AHidRecorderFileReplaysAsADialBox) {
   slot.dialBox->close();
 }
 
+// Makes sure `[input]` (keyboards and mice from evdev) is read and checked like the rest.
+// Example failure: a misspelt mode is taken as "auto" without a word, or a name list holding a
+// number is accepted.
+TEST(ManifestInput, EvdevModesNamesAndMistakes) {
+  ShowFolder f("input");
+  const auto defaults = f.read("[show]\nname = \"x\"\n");
+  ASSERT_TRUE(defaults.manifest) << defaults.text;
+  EXPECT_EQ(defaults.manifest->input.evdev, EvdevMode::kAuto);
+  EXPECT_TRUE(defaults.manifest->input.keyboards);
+  EXPECT_TRUE(defaults.manifest->input.pointers);
+
+  const auto given = f.read("[input]\nevdev = \"on\"\npointers = false\nnames = [\"Dell KB216\", \"Logitech\"]\n");
+  ASSERT_TRUE(given.manifest) << given.text;
+  EXPECT_EQ(given.manifest->input.evdev, EvdevMode::kOn);
+  EXPECT_TRUE(given.manifest->input.keyboards);
+  EXPECT_FALSE(given.manifest->input.pointers);
+  EXPECT_EQ(given.manifest->input.names, (std::vector<std::string>{"Dell KB216", "Logitech"}));
+
+  const auto bad = f.read("[input]\nevdev = \"sometimes\"\nnames = [3]\nmice = true\n");
+  EXPECT_FALSE(bad.manifest);
+  EXPECT_TRUE(hasError(bad, 2, "input.evdev")) << bad.text;
+  EXPECT_TRUE(hasError(bad, 3, "input.names: each entry must be a device name")) << bad.text;
+  EXPECT_TRUE(hasError(bad, 4, "input.mice: unknown key")) << bad.text;
+
+  const auto off = f.read("[output]\nkind = \"window\"\n[input]\nevdev = \"on\"\n");
+  ASSERT_TRUE(off.manifest) << off.text;
+  EXPECT_NE(off.text.find("reads every key twice"), std::string::npos) << off.text;
+}
+
 }  // namespace
 }  // namespace basalt::kiosk
