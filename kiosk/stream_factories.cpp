@@ -167,8 +167,10 @@ class MovieStream final : public TextureStream {
   [[nodiscard]] std::string describe() const override {
     if (!failure_.empty()) return fmt::format("movie {}: {}", media_.file.filename(), failure_);
     const media::MovieInfo info = player_->info();
-    return fmt::format("movie {}: frame {} of {}, {} loops", media_.file.filename(), player_->currentFrame(),
-                       info.frameCount, player_->stats().loops);
+    const media::MoviePlayerStats stats = player_->stats();
+    return fmt::format("movie {}: frame {} of {}, {} loops{}", media_.file.filename(), player_->currentFrame(),
+                       info.frameCount, stats.loops,
+                       stats.stalls > 0 ? fmt::format(", restarted {} times after a stall", stats.stalls) : "");
   }
 
  private:

@@ -218,9 +218,10 @@ std::vector<std::string> VideoStreams::status() const {
       case media::MovieState::kEmpty: break;
     }
     const media::MoviePlayerStats st = s->player->stats();
-    lines.push_back(fmt::format("movie '{}': {} ({}), frame {} of {}, {} shown, {} loops; {}", s->spec.name,
-                                info.path.filename(), state, s->player->currentFrame(), info.frameCount, st.shown,
-                                st.loops, s->texture->describe()));
+    lines.push_back(fmt::format(
+        "movie '{}': {} ({}), frame {} of {}, {} shown, {} loops{}; {}", s->spec.name, info.path.filename(), state,
+        s->player->currentFrame(), info.frameCount, st.shown, st.loops,
+        st.stalls > 0 ? fmt::format(", restarted {} times after a stall", st.stalls) : "", s->texture->describe()));
   }
   return lines;
 }

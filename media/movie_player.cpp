@@ -240,7 +240,7 @@ struct MoviePlayer::Impl {
   std::thread worker;
 
   struct Command {
-    enum class Kind : std::uint8_t { kLoad, kSeek, kUnload, kRepeat, kQuit } kind;
+    enum class Kind : std::uint8_t { kLoad, kSeek, kUnload, kRepeat, kInjectStall, kQuit } kind;
     std::uint64_t generation = 0;
     std::vector<std::filesystem::path> paths;
     std::int64_t index = 0;
@@ -263,6 +263,7 @@ struct MoviePlayer::Impl {
   std::atomic<std::uint64_t> decoded{0};
   std::atomic<std::uint64_t> shown{0};
   std::atomic<std::uint64_t> loops{0};
+  std::atomic<std::uint64_t> stalls{0};
 
   // Decoder thread only:
   std::vector<std::filesystem::path> playlist;
@@ -277,6 +278,10 @@ struct MoviePlayer::Impl {
   Nanos lastPts{-1};           // timeline pts of the last frame pushed
   std::int64_t lastIndex = -1;
   bool clipEnded = false;
+  // Since when the clip playing has had room in the queue and delivered nothing (the stall
+  // watchdog); reset by every frame, full queue, end of clip and command.
+  std::optional<std::chrono::steady_clock::time_point> starvedSince;
+  bool recovering = false;  // a stalled pipeline was built again; its first frame says so
 
   void post(Command c) {
     {
@@ -307,6 +312,9 @@ struct MoviePlayer::Impl {
   void deliver(GstSample* sample);
   void endOfClip();
   void prerollNext();
+  void watchStarvation();
+  void restartStalled(std::chrono::steady_clock::duration starved);
+  void blockVideo();
   Nanos frameDuration() const { return current ? current->info.frameDuration : Nanos{33333333}; }
 };
 
@@ -494,11 +502,16 @@ void MoviePlayer::Impl::deliver(GstSample* sample) {
       std::llround(static_cast<double>((pts - clip.start).count()) / static_cast<double>(dur.count())));
   if (index < dropBelow) return;  // decoded on the way to an accurate seek's target
   dropBelow = 0;
+  // After a seek the first frame lands on seekTimeline and the rest follow it by their
+  // timestamps. The base comes from the frame's number, not its timestamp: an accurate seek's
+  // first frame is clipped to the seek's target (a quarter frame past its start).
+  bool rebased = false;
   if (rebase) {
-    base = seekTimeline - (pts - clip.start);
+    base = seekTimeline - dur * index;
     rebase = false;
+    rebased = true;
   }
-  Nanos timeline = base + (pts - clip.start);
+  Nanos timeline = base + (rebased ? dur * index : pts - clip.start);
   if (lastPts.count() >= 0 && timeline <= lastPts) timeline = lastPts + Nanos{1};  // keep the queue ordered
 
   FrameRef frame;
@@ -514,6 +527,11 @@ void MoviePlayer::Impl::deliver(GstSample* sample) {
   lastPts = timeline;
   lastIndex = index;
   decoded.fetch_add(1, std::memory_order_relaxed);
+  if (recovering) {
+    recovering = false;
+    log::info(kLogMedia, "{}: frames flow again from frame {} of {}", options.name, index,
+              clip.path.filename().string());
+  }
   if (queue.tryPush(std::move(frame))) {
     {
       std::lock_guard lock(mutex);
@@ -669,6 +687,7 @@ bool MoviePlayer::Impl::handleCommands() {
       c = std::move(commands.front());
       commands.pop_front();
     }
+    starvedSince.reset();
     switch (c.kind) {
       case Command::Kind::kQuit: return false;
       case Command::Kind::kLoad: load(c); break;
@@ -679,6 +698,7 @@ bool MoviePlayer::Impl::handleCommands() {
         current.reset();
         queue.clear();
         break;
+      case Command::Kind::kInjectStall: blockVideo(); break;
       case Command::Kind::kRepeat:
         repeat = c.flag;
         if (repeat && clipEnded && current) {
@@ -694,6 +714,67 @@ bool MoviePlayer::Impl::handleCommands() {
         break;
     }
   }
+}
+
+void MoviePlayer::Impl::watchStarvation() {
+  const auto now = std::chrono::steady_clock::now();
+  if (!starvedSince) {
+    starvedSince = now;
+    return;
+  }
+  const auto limit = std::max<std::chrono::steady_clock::duration>(options.stallTimeout, 4 * frameDuration());
+  if (now - *starvedSince < limit) return;
+  const auto starved = now - *starvedSince;
+  starvedSince.reset();
+  restartStalled(starved);
+}
+
+void MoviePlayer::Impl::restartStalled(std::chrono::steady_clock::duration starved) {
+  const std::size_t entry = current->entry;
+  const Nanos start = current->start;
+  const std::int64_t resumeAt = lastIndex + 1;
+  stalls.fetch_add(1, std::memory_order_relaxed);
+  log::warn(kLogMedia,
+            "{}: no frame from {} for {:.1f} s though there was room for one: its pipeline stalled; building it "
+            "again and resuming at frame {}",
+            options.name, current->path.filename().string(), std::chrono::duration<double>(starved).count(), resumeAt);
+  // Torn down first: stopping flushes its pads, which releases the threads that hang.
+  next.reset();
+  current.reset();
+  auto clip = openClip(entry, true);
+  if (!clip) {
+    setFailed(clip.error());
+    return;
+  }
+  current = std::move(*clip);
+  // The same file: frame 0 has the same stream time, so the timeline goes on where it was.
+  current->start = start;
+  if (resumeAt > 0 && start.count() >= 0) {
+    const Nanos dur = current->info.frameDuration;
+    const bool seeked = current->info.seekable &&
+                        gst_element_seek_simple(current->pipeline.get(), GST_FORMAT_TIME,
+                                                static_cast<GstSeekFlags>(GST_SEEK_FLAG_FLUSH | GST_SEEK_FLAG_ACCURATE),
+                                                static_cast<gint64>((start + dur * resumeAt + dur / 4).count()));
+    (void)seeked;  // not seekable: decoded from the top, the frames before resumeAt dropped
+    dropBelow = resumeAt;
+    // The next frame is due one frame after the last one queued, as if nothing had happened.
+    rebase = true;
+    seekTimeline = lastPts + dur;
+  }
+  gst_element_set_state(current->pipeline.get(), GST_STATE_PLAYING);
+  recovering = true;
+  prerollNext();
+}
+
+void MoviePlayer::Impl::blockVideo() {
+  if (!current || !current->sink) return;
+  GstPad* pad = gst_element_get_static_pad(current->sink, "sink");
+  if (!pad) return;
+  gst_pad_add_probe(
+      pad, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM,
+      [](GstPad*, GstPadProbeInfo*, gpointer) -> GstPadProbeReturn { return GST_PAD_PROBE_OK; }, nullptr, nullptr);
+  gst_object_unref(pad);
+  log::warn(kLogMedia, "{}: its video stream is blocked on purpose (a stall drill)", options.name);
 }
 
 void MoviePlayer::Impl::run() {
@@ -717,13 +798,22 @@ void MoviePlayer::Impl::run() {
     }
     if (!current || clipEnded) continue;
     if (!pollBus(*current)) continue;
-    if (!queue.waitForRoom(kPoll)) continue;
+    if (!queue.waitForRoom(kPoll)) {
+      starvedSince.reset();  // the decoder is ahead of the show: nothing is wrong
+      continue;
+    }
     SamplePtr sample(gst_app_sink_try_pull_sample(reinterpret_cast<GstAppSink*>(current->sink),
                                                   static_cast<GstClockTime>(std::chrono::nanoseconds(kPoll).count())));
     if (!sample) {
-      if (gst_app_sink_is_eos(reinterpret_cast<GstAppSink*>(current->sink))) endOfClip();
+      if (gst_app_sink_is_eos(reinterpret_cast<GstAppSink*>(current->sink))) {
+        starvedSince.reset();
+        endOfClip();
+      } else {
+        watchStarvation();
+      }
       continue;
     }
+    starvedSince.reset();
     deliver(sample.get());
   }
   next.reset();
@@ -831,8 +921,11 @@ MoviePlayerStats MoviePlayer::stats() const {
   s.shown = impl_->shown.load(std::memory_order_relaxed);
   s.passed = impl_->queue.dropped();
   s.loops = impl_->loops.load(std::memory_order_relaxed);
+  s.stalls = impl_->stalls.load(std::memory_order_relaxed);
   return s;
 }
+
+void MoviePlayer::injectStall() { impl_->post({Impl::Command::Kind::kInjectStall, 0, {}, 0, Nanos{0}, false}); }
 
 std::int64_t MoviePlayer::frameCount() const { return info().frameCount; }
 

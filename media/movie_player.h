@@ -62,6 +62,10 @@ struct MoviePlayerOptions {
   /// decoder's planes on: only for comparisons (the naive path in the benchmarks). kUnknown
   /// (the default) keeps the decoder's format.
   PixelFormat cpuConvertTo = PixelFormat::kUnknown;
+  /// A clip that is playing, with room in the queue, but delivers no frame for this long (or
+  /// four frame durations, if longer) has stalled: its pipeline is built again and resumes at
+  /// the next frame, so that a kiosk's texture keeps moving.
+  std::chrono::milliseconds stallTimeout{5000};
 };
 
 /// \brief Counters for the status server and tests.
@@ -70,6 +74,7 @@ struct MoviePlayerStats {
   std::uint64_t shown = 0;    ///< frames frameAt() returned
   std::uint64_t passed = 0;   ///< frames decoded but passed over (shuttle, late decoder)
   std::uint64_t loops = 0;    ///< times a clip restarted or the playlist moved on
+  std::uint64_t stalls = 0;   ///< times a stalled pipeline was built again
 };
 
 /// \brief A movie file (or a playlist of them) as a FrameSource, with LAVA's VCR controls.
@@ -140,6 +145,10 @@ class MoviePlayer final : public FrameSource {
   /// blocks. Frames come in the format the decoder made (YUV planes: the renderer converts).
   FrameRef frameAt(Nanos showTime) override;
 
+  /// \brief Fault injection for tests and drills: blocks the video stream of the clip playing
+  /// now (a blocking probe in front of its sink), as a decoder that hangs does, so that the
+  /// stall watchdog has something to recover from.
+  void injectStall();
   /// \brief Waits until the loaded movie is ready or failed (tests, tools, `basalt check`).
   [[nodiscard]] Result<MovieInfo> waitUntilLoaded(std::chrono::milliseconds timeout);
   /// \brief For offline rendering on a manual clock only: waits until the frame due at

@@ -41,13 +41,14 @@ bool FrameQueue::waitForRoom(std::chrono::nanoseconds timeout) {
 
 FrameRef FrameQueue::takeDue(Nanos now) {
   FrameRef newest;
-  FrameRef older;
   bool tookAny = false;
-  {
-    std::lock_guard lock(mutex_);
-    while (size_ > 0 && slots_[head_]->pts <= now) {
+  for (;;) {
+    FrameRef older;  // passed over: released outside the lock, where its release hook may lock
+    {
+      std::lock_guard lock(mutex_);
+      if (size_ == 0 || slots_[head_]->pts > now) break;
       if (newest) {
-        older = std::move(newest);  // released below, outside the lock
+        older = std::move(newest);
         ++dropped_;
       }
       newest = popFrontLocked();
@@ -55,7 +56,6 @@ FrameRef FrameQueue::takeDue(Nanos now) {
     }
   }
   if (tookAny) room_.notify_all();
-  older.reset();
   return newest;
 }
 
