@@ -1,7 +1,8 @@
 // Real hardware paths the contract suites do not cover, run in the virtual lab (skipping with the
 // reason elsewhere): an HDMI input that loses its signal, gets it back and changes resolution
 // renegotiates by itself (vivid's "DV Timings Signal Mode" control); USB gadgets unplugged and
-// replugged from their UDC drive the DeviceManager through lost and back to live through udev;
+// replugged from their UDC, and vivid unbound from its driver and bound again, drive the
+// DeviceManager through lost and back to live through udev;
 // V4L2 enumeration describes vivid's nodes.
 // Example failures: a capture thread stuck in DQBUF after the signal went; a stream that stays
 // lost after the cable is back; a dial box that needs a restart after a replug.
@@ -10,6 +11,9 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <thread>
 
 #include "devices/device_manager.h"
@@ -94,7 +98,21 @@ bool gadgetCtl(const std::string& what, const std::string& gadget) {
   return std::system(cmd.c_str()) == 0;
 }
 
-void hotplugRoundTrip(DeviceKind kind, const std::string& gadget, DeviceMatch match,
+/// The cable of gadget `name`: pulled (false) and plugged in (true).
+std::function<bool(bool)> gadget(const std::string& name) {
+  return [name](bool plug) { return gadgetCtl(plug ? "plug" : "unplug", name); };
+}
+
+/// Unbinds or binds (plug) a platform device from its driver through sysfs, as a driver reload
+/// or a capture card's firmware reset does.
+bool platformBind(const std::string& driver, const std::string& device, bool plug) {
+  std::ofstream out("/sys/bus/platform/drivers/" + driver + (plug ? "/bind" : "/unbind"));
+  out << device;
+  out.flush();
+  return static_cast<bool>(out);
+}
+
+void hotplugRoundTrip(DeviceKind kind, const std::function<bool(bool plug)>& cable, DeviceMatch match,
                       std::unique_ptr<DeviceProvider> provider) {
   SystemClock clock;
   BoundedQueue<Event> events(4096);
@@ -111,9 +129,9 @@ void hotplugRoundTrip(DeviceKind kind, const std::string& gadget, DeviceMatch ma
   auto state = [&] { return manager.status()[0].state; };
   auto idle = [] {};
   ASSERT_TRUE(waitFor(idle, [&] { return state() == DeviceState::kLive; }, 10s)) << manager.status()[0].lastError;
-  ASSERT_TRUE(gadgetCtl("unplug", gadget));
+  ASSERT_TRUE(cable(false));
   EXPECT_TRUE(waitFor(idle, [&] { return state() == DeviceState::kLost || state() == DeviceState::kReopening; }, 10s));
-  ASSERT_TRUE(gadgetCtl("plug", gadget));
+  ASSERT_TRUE(cable(true));
   EXPECT_TRUE(waitFor(
       idle, [&] { return state() == DeviceState::kLive; }, 20s))
       << "not live again after the replug: " << manager.status()[0].lastError;
@@ -129,7 +147,7 @@ TEST(HotplugHardware, DialGadgetUnpluggedAndReplugged) {
   DeviceMatch m;
   m.backend = "hid";
   ASSERT_TRUE(parseVendorProduct(*ids, m));
-  hotplugRoundTrip(DeviceKind::kDialBox, "dial", m, std::make_unique<HidProvider>());
+  hotplugRoundTrip(DeviceKind::kDialBox, gadget("dial"), m, std::make_unique<HidProvider>());
 }
 
 TEST(HotplugHardware, PowerMateGadgetUnpluggedAndReplugged) {
@@ -140,7 +158,7 @@ TEST(HotplugHardware, PowerMateGadgetUnpluggedAndReplugged) {
   m.backend = "hid";
   m.vendor = 0x077d;
   m.product = 0x0410;
-  hotplugRoundTrip(DeviceKind::kDialBox, "powermate", m, std::make_unique<HidProvider>());
+  hotplugRoundTrip(DeviceKind::kDialBox, gadget("powermate"), m, std::make_unique<HidProvider>());
 }
 
 TEST(HotplugHardware, UvcGadgetUnpluggedAndReplugged) {
@@ -154,7 +172,28 @@ TEST(HotplugHardware, UvcGadgetUnpluggedAndReplugged) {
   auto d = describeV4l2Device(*node);
   ASSERT_TRUE(d) << d.error().describe();
   m.name = d->card;  // the node may get another number after the replug: match by name
-  hotplugRoundTrip(DeviceKind::kVideoSource, "uvc", m, std::make_unique<V4l2Provider>());
+  hotplugRoundTrip(DeviceKind::kVideoSource, gadget("uvc"), m, std::make_unique<V4l2Provider>());
+}
+
+// vivid's webcam instance unbound from its driver and bound again while Basalt streams it (what
+// a driver reload does): lost, then live again through the DeviceManager and udev, matched by
+// its card name; the node comes back where the lab's other cases expect it.
+TEST(HotplugHardware, VividUnboundAndBoundAgain) {
+  const auto node = test::vlabEnv("BASALT_VLAB_V4L2_WEBCAM");
+  if (!node) GTEST_SKIP() << test::needsVlab("BASALT_VLAB_V4L2_WEBCAM (vivid webcam input)");
+  if (!std::filesystem::exists("/sys/bus/platform/drivers/vivid/vivid.0")) {
+    GTEST_SKIP() << "vivid.0 is not bound to the vivid driver here";
+  }
+  auto d = describeV4l2Device(*node);
+  ASSERT_TRUE(d) << d.error().describe();
+  DeviceMatch m;
+  m.backend = "v4l2";
+  m.name = d->card;
+  hotplugRoundTrip(
+      DeviceKind::kVideoSource, [](bool plug) { return platformBind("vivid", "vivid.0", plug); }, m,
+      std::make_unique<V4l2Provider>());
+  EXPECT_TRUE(waitFor([] {}, [&] { return std::filesystem::exists(*node); }, 10s))
+      << *node << " did not come back (later cases use it)";
 }
 
 TEST(UdevHotplug, MonitorStartsOrSaysWhy) {
