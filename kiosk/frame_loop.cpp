@@ -99,10 +99,24 @@ Result<FrameLoopStats> FrameLoop::run() {
       if (handle) loop.unwatch(*handle);
     }
   } unwatch{loop_, pace};
-  for (std::int64_t frame = 0; config_.maxFrames < 0 || frame < config_.maxFrames; ++frame) {
+  std::int64_t drawn = 0;
+  for (std::int64_t frame = 0; config_.maxFrames < 0 || drawn < config_.maxFrames; ++frame) {
     if (auto r = waitForOutput(); !r) return std::unexpected(r.error());
-    const Nanos due = start + frameTime(frame, config_.fps);
-    if (manual_) {
+    Nanos due = start + frameTime(frame, config_.fps);
+    if (gate_) {
+      // A follower: the leader says which frame comes next and when it is; none for a while
+      // keeps the last picture on the output.
+      std::optional<GatedFrame> next;
+      while (!next && !stopRequested_) {
+        auto got = gate_->nextFrame(loop_, std::chrono::milliseconds(100));
+        if (!got) return std::unexpected(got.error());
+        next = *got;
+      }
+      if (!next || next->end) break;
+      frame = next->frame;
+      due = next->time;
+      if (manual_) manual_->set(due);
+    } else if (manual_) {
       manual_->set(due);
       // Signals and wake-ups still get through; the manual clock never waits.
       if (auto r = loop_.dispatch(Nanos{0}); !r) return std::unexpected(r.error());
@@ -116,12 +130,13 @@ Result<FrameLoopStats> FrameLoop::run() {
       if (clock_.now() - due > frameTime(1, config_.fps)) ++stats.lateFrames;
     }
     const bool last =
-        stopRequested_ || participantWantsStop() || (config_.maxFrames >= 0 && frame + 1 == config_.maxFrames);
+        stopRequested_ || participantWantsStop() || (config_.maxFrames >= 0 && drawn + 1 == config_.maxFrames);
     applyInput(due);
     FrameContext context{frame, due, last};
     if (auto r = renderFrame(context); !r) return std::unexpected(r.error());
-    if (frame == 0) stats.firstFrameSeconds = toSeconds(wall.now() - wallStart);
-    stats.frames = frame + 1;
+    if (drawn == 0) stats.firstFrameSeconds = toSeconds(wall.now() - wallStart);
+    ++drawn;
+    stats.frames = drawn;
     stats.showTime = due - start;
     // LAVA's performance meter: this frame's counts, rates over real time.
     show_.performance().recordFrame(renderer_.takeFrameCounts(), wall.now());

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "render/output.h"
@@ -63,6 +64,24 @@ class FrameParticipant {
   [[nodiscard]] virtual bool wantsStop() const { return false; }
 };
 
+/// \brief A frame a follower's gate hands the loop: the leader's number and show time.
+struct GatedFrame {
+  std::int64_t frame = 0;
+  Nanos time{0};
+  bool end = false;  ///< the group ends: draw nothing more
+};
+
+/// \brief Where a frame-locked follower's frames come from (kiosk/frame_lock.h): with a gate, the
+/// loop draws the frames it hands over, numbered and timed as the leader's, instead of pacing
+/// itself on the clock.
+class FrameGate {
+ public:
+  virtual ~FrameGate() = default;
+  /// \brief Waits at most `patience`, serving `loop`, for the next frame to draw; nothing when
+  /// none came (the loop asks again and the output keeps its last picture).
+  virtual Result<std::optional<GatedFrame>> nextFrame(runtime::EventLoop& loop, Nanos patience) = 0;
+};
+
 struct FrameLoopConfig {
   double fps = 60;
   std::int64_t maxFrames = -1;  ///< stop after this many frames; -1 runs until stopped
@@ -99,6 +118,9 @@ class FrameLoop {
   /// \brief Draws the frame's views instead of the one plain view (a manifest's `[[views]]`:
   /// facets, eyes, tiles); borrowed, null for the plain view.
   void setViewDrawer(ViewDrawer* drawer) { viewDrawer_ = drawer; }
+  /// \brief Takes frame numbers and times from `gate` (a frame-locked follower); borrowed, null
+  /// to pace on the clock. `maxFrames` then counts the frames drawn.
+  void setGate(FrameGate* gate) { gate_ = gate; }
   void setEvents(BoundedQueue<Event>* events, runtime::Bindings* bindings) {
     events_ = events;
     bindings_ = bindings;
@@ -129,6 +151,7 @@ class FrameLoop {
   BoundedQueue<Event>* events_ = nullptr;
   runtime::Bindings* bindings_ = nullptr;  // stateful: dial speeds and shuttles
   ViewDrawer* viewDrawer_ = nullptr;
+  FrameGate* gate_ = nullptr;
   Nanos lastInput_{-1};
   bool stopRequested_ = false;
 };

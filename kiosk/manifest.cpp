@@ -501,8 +501,9 @@ class Reader {
     manifest_.name = manifest_.folder.filename().string();
     manifest_.entry = {EntryKind::kBuiltinDefault, "default", {}, 0};
 
-    checkKeys(root, "",
-              {"show", "output", "views", "media", "devices", "bindings", "textures", "kiosk", "status", "input"});
+    checkKeys(
+        root, "",
+        {"show", "output", "views", "media", "devices", "bindings", "textures", "kiosk", "status", "input", "lock"});
     if (const toml::table* t = table(root, "show", "")) readShow(*t);
     if (const toml::table* t = table(root, "output", "")) readOutput(*t);
     readViews(root);
@@ -514,6 +515,7 @@ class Reader {
     if (const toml::table* t = table(root, "kiosk", "")) readKiosk(*t);
     if (const toml::table* t = table(root, "status", "")) readStatus(*t);
     if (const toml::table* t = table(root, "input", "")) readInput(*t);
+    if (const toml::table* t = table(root, "lock", "")) readLock(*t);
 
     // By line, keeping the order of problems found on the same line.
     std::vector<std::size_t> order(diagsOwn_.size());
@@ -1778,6 +1780,46 @@ class Reader {
     if (in.evdev == EvdevMode::kOn && manifest_.output.kind == OutputKind::kWindow) {
       warning(t.get("evdev") ? lineOf(*t.get("evdev")) : in.line,
               "input.evdev: 'on' with the window output reads every key twice (the window delivers them too)");
+    }
+  }
+
+  // ---- [lock] ----
+  void readLock(const toml::table& t) {
+    LockSpec& l = manifest_.lock;
+    l.line = lineOf(t);
+    checkKeys(t, "lock",
+              {"role", "node", "leader", "listen", "port", "followers", "join_timeout_ms", "timeout_ms", "drop_after",
+               "leader_timeout_ms", "clock"});
+    if (auto role =
+            choice<LockRole>(t, "role", "lock", {{"leader", LockRole::kLeader}, {"follower", LockRole::kFollower}})) {
+      l.role = *role;
+    } else if (!t.get("role")) {
+      error(l.line, "lock: needs role = \"leader\" or \"follower\"");
+    }
+    if (auto node = string(t, "node", "lock")) {
+      if (node->empty() || node->size() > 32) {
+        error(lineOf(*t.get("node")), "lock.node: a name of 1 to 32 characters, unique in the group");
+      } else {
+        l.node = *node;
+      }
+    }
+    if (auto leader = string(t, "leader", "lock")) l.leader = *leader;
+    if (auto listen = string(t, "listen", "lock")) l.listen = *listen;
+    if (auto port = integer(t, "port", "lock", 1, 65533)) l.port = static_cast<int>(*port);
+    if (auto n = integer(t, "followers", "lock", 0, 256)) l.followers = static_cast<int>(*n);
+    if (auto ms = integer(t, "join_timeout_ms", "lock", 0, 600000)) l.joinTimeoutMs = static_cast<int>(*ms);
+    if (auto ms = integer(t, "timeout_ms", "lock", 1, 10000)) l.timeoutMs = static_cast<int>(*ms);
+    if (auto n = integer(t, "drop_after", "lock", 1, 10000)) l.dropAfter = static_cast<int>(*n);
+    if (auto ms = integer(t, "leader_timeout_ms", "lock", 10, 600000)) l.leaderTimeoutMs = static_cast<int>(*ms);
+    if (auto clock = boolean(t, "clock", "lock")) l.clock = *clock;
+    if (l.role == LockRole::kFollower && l.leader.empty()) {
+      error(l.line, "lock: a follower needs leader = \"ADDRESS\" (the leader's IP address or host name)");
+    }
+    if (l.role == LockRole::kLeader && t.get("leader")) {
+      warning(lineOf(*t.get("leader")), "lock.leader: ignored on the leader (it listens on lock.listen)");
+    }
+    if (l.role == LockRole::kFollower && (t.get("followers") || t.get("timeout_ms") || t.get("drop_after"))) {
+      warning(l.line, "lock: followers, timeout_ms and drop_after are the leader's; a follower ignores them");
     }
   }
 

@@ -322,6 +322,24 @@ struct InputSpec {
   int line = 0;
 };
 
+/// \brief `[lock]`: frame-locked display nodes (thesis §4.5, kiosk/frame_lock.h).
+enum class LockRole : std::uint8_t { kOff, kLeader, kFollower };
+
+struct LockSpec {
+  LockRole role = LockRole::kOff;
+  std::string node;                ///< this node's name (default: the host name); unique in the group
+  std::string leader;              ///< follower: the leader's address (IP or host name)
+  std::string listen = "0.0.0.0";  ///< leader: the address its sockets listen on
+  int port = 5560;                 ///< frames on port, answers on port + 1, the network clock on port + 2
+  int followers = 0;               ///< leader: followers to wait for before the first frame
+  int joinTimeoutMs = 5000;        ///< leader: how long to wait for them
+  int timeoutMs = 20;              ///< leader: how long each frame waits for the followers' answers
+  int dropAfter = 3;               ///< leader: missed frames in a row before a follower leaves the barrier
+  int leaderTimeoutMs = 1000;      ///< follower: silence before the leader is reported lost
+  bool clock = true;               ///< share the leader's clock (GStreamer's network clock)
+  int line = 0;
+};
+
 /// \brief A whole show manifest, validated.
 struct Manifest {
   std::filesystem::path file;    ///< absolute path of show.toml
@@ -338,6 +356,7 @@ struct Manifest {
   KioskSpec kiosk;
   StatusSpec status;
   InputSpec input;
+  LockSpec lock;
 
   /// \brief A manifest for the built-in default show: no file, every default.
   static Manifest builtinDefault();

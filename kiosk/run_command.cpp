@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -18,6 +19,7 @@
 #include "kiosk/commands.h"
 #include "kiosk/device_wiring.h"
 #include "kiosk/display_views.h"
+#include "kiosk/frame_lock.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/frame_metrics.h"
 #include "kiosk/manifest.h"
@@ -33,6 +35,7 @@
 #include "kiosk/supervisor.h"
 #include "kiosk/trace_video_glue.h"
 #include "media/image_io.h"
+#include "media/net_clock.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/event_loop.h"
@@ -420,6 +423,24 @@ Result<void> applyStatusListen(std::string_view listen, StatusSpec& spec) {
   return {};
 }
 
+/// The lock's view of the network clock: its offset from this node's own clock.
+class NetClockProbe final : public LockClockProbe {
+ public:
+  explicit NetClockProbe(const media::NetClock& clock) : clock_(clock) {}
+  [[nodiscard]] Nanos offset() const override { return clock_.offset(); }
+
+ private:
+  const media::NetClock& clock_;
+};
+
+std::string hostName() {
+  std::array<char, 256> name{};
+  if (::gethostname(name.data(), name.size() - 1) != 0) return "node";
+  std::string n(name.data());
+  if (n.size() > 32) n.resize(32);
+  return n;
+}
+
 }  // namespace
 
 int runShow(const RunOptions& options) {
@@ -464,7 +485,27 @@ int runShow(const RunOptions& options) {
   const bool manual = options.clock == ClockMode::kManual || (options.clock == ClockMode::kAuto && batch);
   SystemClock systemClock;
   ManualClock manualClock(Nanos{0}, options.clockStart ? *options.clockStart : systemClock.wallNow());
-  const Clock& clock = manual ? static_cast<const Clock&>(manualClock) : systemClock;
+  // Frame-locked nodes share the leader's clock (GStreamer's network clock): the leader serves
+  // its monotonic clock, a follower paced in real time reads it as its show clock.
+  const LockSpec& lockSpec = manifest.lock;
+  std::unique_ptr<media::NetClockServer> clockServer;
+  std::unique_ptr<media::NetClock> netClock;
+  if (lockSpec.role == LockRole::kLeader && lockSpec.clock) {
+    auto served = media::NetClockServer::start(lockSpec.listen, lockSpec.port + 2);
+    if (!served) return failWith(served.error(), "cannot share the clock");
+    clockServer = std::move(*served);
+  } else if (lockSpec.role == LockRole::kFollower && lockSpec.clock) {
+    auto followed = media::NetClock::connect(lockSpec.leader, lockSpec.port + 2);
+    if (!followed) return failWith(followed.error(), "cannot follow the leader's clock");
+    netClock = std::move(*followed);
+    if (!netClock->waitForSync(std::chrono::seconds(2))) {
+      log::warn(kLogRun, "the leader's clock at {}:{} did not answer within 2 s; following it when it does",
+                lockSpec.leader, lockSpec.port + 2);
+    }
+  }
+  const Clock& clock = manual     ? static_cast<const Clock&>(manualClock)
+                       : netClock ? static_cast<const Clock&>(*netClock)
+                                  : static_cast<const Clock&>(systemClock);
 
   auto loop = runtime::EventLoop::create(clock);
   if (!loop) return failWith(loop.error(), "cannot start the event loop");
@@ -666,6 +707,32 @@ int runShow(const RunOptions& options) {
     devices->start(manual);
   }
 
+  // [lock]: the frame lock is the last participant, so that the leader sends the frame's final
+  // state and a follower's state from the leader is what is drawn.
+  std::unique_ptr<FrameLock> lock;
+  std::optional<NetClockProbe> clockProbe;
+  if (lockSpec.role != LockRole::kOff) {
+    LockSpec spec = lockSpec;
+    if (spec.node.empty()) spec.node = hostName();
+    auto made = FrameLock::create(spec, clock, show);
+    if (!made) return failWith(made.error(), "cannot lock frames with the other nodes");
+    lock = std::move(*made);
+    if (netClock) {
+      clockProbe.emplace(*netClock);
+      lock->setClockProbe(&*clockProbe);
+      lock->setSharedClock(*netClock);
+    }
+    frameLoop.addParticipant(*lock);
+    if (lock->leader()) {
+      const std::int64_t joined = lock->awaitFollowers(**loop);
+      fmt::print("basalt: frame lock: leader '{}', {} of {} followers joined\n", spec.node, joined, spec.followers);
+    } else {
+      frameLoop.setGate(lock.get());
+      fmt::print("basalt: frame lock: follower '{}' of the leader at {}\n", spec.node, spec.leader);
+    }
+    std::fflush(stdout);
+  }
+
   Image snapshot;
   bool snapshotWritten = false;
   frameLoop.setFrameHook([&](std::int64_t, bool last, render::Output& out) -> Result<void> {
@@ -677,6 +744,7 @@ int runShow(const RunOptions& options) {
   });
 
   auto stats = frameLoop.run();
+  if (lock && lock->leader() && stats) lock->sayBye(stats->frames - 1);
   std::vector<devices::DeviceStatus> deviceStatus;
   if (devices) {
     deviceStatus = devices->manager().status();
@@ -713,6 +781,7 @@ int runShow(const RunOptions& options) {
   if (const KioskPolicy* policy = director.policy(); policy && options.manifest) {
     fmt::print("basalt: at the end: {}\n", policy->describe());
   }
+  if (lock) fmt::print("basalt: {}\n", lock->describe());
   if (snapshotWritten) fmt::print("basalt: snapshot written to {}\n", snapshotPath.string());
   if (options.saveModel) fmt::print("basalt: model saved to {}\n", options.saveModel->string());
   if (videos) {

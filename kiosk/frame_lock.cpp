@@ -1,0 +1,518 @@
+// Frame-locked nodes over ZeroMQ (libzmq's C API; Debian's libzmq3-dev). The leader binds a PUB
+// socket on `port` (frames, presents, byes, join beacons) and a ROUTER socket on `port + 1`
+// (followers' answers); a follower connects a SUB and a DEALER whose routing id is its node
+// name. Nothing here blocks for longer than the spec's time-outs: the leader's barrier waits at
+// most `timeout_ms` per frame, a follower's wait for "present" at most `leader_timeout_ms`.
+// Over TCP a lost packet is a retransmission, so loss shows as delay: late answers, frames a
+// follower skips and presents without the leader's word, all counted.
+
+#include "kiosk/frame_lock.h"
+
+#include <zmq.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstring>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "kiosk/manifest.h"
+#include "runtime/log.h"
+#include "runtime/show/show.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Lock, "lock");
+
+namespace {
+
+struct ZmqContextClose {
+  void operator()(void* c) const {
+    if (c) zmq_ctx_term(c);
+  }
+};
+struct ZmqSocketClose {
+  void operator()(void* s) const {
+    if (s) zmq_close(s);
+  }
+};
+using ZmqContext = std::unique_ptr<void, ZmqContextClose>;
+using ZmqSocket = std::unique_ptr<void, ZmqSocketClose>;
+
+Result<ZmqSocket> makeSocket(void* context, int type, std::string_view what) {
+  ZmqSocket s(zmq_socket(context, type));
+  if (!s)
+    return failf(Errc::kUnavailable, "frame lock: cannot make the {} socket: {}", what, zmq_strerror(zmq_errno()));
+  const int linger = 0;  // closing never waits for peers that are gone
+  zmq_setsockopt(s.get(), ZMQ_LINGER, &linger, sizeof linger);
+  const int hwm = 256;  // a few seconds of frames; beyond that a slow peer loses the oldest
+  zmq_setsockopt(s.get(), ZMQ_SNDHWM, &hwm, sizeof hwm);
+  zmq_setsockopt(s.get(), ZMQ_RCVHWM, &hwm, sizeof hwm);
+  return s;
+}
+
+std::string endpoint(std::string_view host, int port) { return fmt::format("tcp://{}:{}", host, port); }
+
+/// A fixed ring of samples in milliseconds (no allocation per frame), medians on demand.
+class Samples {
+ public:
+  void add(double ms) {
+    ring_[next_ % ring_.size()] = ms;
+    ++next_;
+    max_ = std::max(max_, ms);
+  }
+  [[nodiscard]] double median() const {
+    const std::size_t n = std::min<std::size_t>(next_, ring_.size());
+    if (n == 0) return 0;
+    std::vector<double> copy(ring_.begin(), ring_.begin() + static_cast<std::ptrdiff_t>(n));
+    std::nth_element(copy.begin(), copy.begin() + static_cast<std::ptrdiff_t>(n / 2), copy.end());
+    return copy[n / 2];
+  }
+  [[nodiscard]] double max() const { return max_; }
+
+ private:
+  std::array<double, 600> ring_{};
+  std::size_t next_ = 0;
+  double max_ = 0;
+};
+
+double millis(Nanos t) { return std::chrono::duration<double, std::milli>(t).count(); }
+
+struct Follower {
+  std::int64_t lastReady = -2;
+  std::int64_t missed = 0;
+  bool inBarrier = true;
+  std::int64_t clockOffsetNs = 0;
+  std::int64_t skipped = 0;
+};
+
+}  // namespace
+
+struct FrameLock::Impl {
+  LockSpec spec;
+  const Clock& clock;
+  runtime::Show& show;
+  const LockClockProbe* probe = nullptr;
+  SystemClock ownClock;
+  const Clock* shared = &ownClock;  // the clock every node reads alike (send and receive times)
+  ZmqContext context;
+  ZmqSocket pub;      // leader: PUB; follower: SUB
+  ZmqSocket answers;  // leader: ROUTER; follower: DEALER
+  LockBuffer buffer{};
+  FrameLockFigures figures;
+  Samples barrierWait;
+  Samples delay;
+  // Leader.
+  std::map<std::string, Follower, std::less<>> followers;
+  // Follower.
+  std::optional<FrameMessage> pending;  // the newest frame received and not drawn yet
+  std::int64_t current = -1;            // the frame being drawn
+  std::int64_t newestPresented = -1;
+  Nanos lastHeard{-1};
+  bool byeSeen = false;
+  bool joined = false;
+  bool waitingReported = false;
+  Nanos lastHello{-1};
+
+  Impl(const LockSpec& s, const Clock& c, runtime::Show& sh) : spec(s), clock(c), show(sh) {}
+
+  [[nodiscard]] bool isLeader() const { return spec.role == LockRole::kLeader; }
+
+  void send(void* socket, std::size_t n) {
+    // Never blocks: a peer whose queue is full loses the message (PUB drops; DEALER with no
+    // connection yet returns EAGAIN), which the protocol survives.
+    (void)zmq_send(socket, buffer.data(), n, ZMQ_DONTWAIT);
+  }
+
+  // ---- Leader ----
+
+  /// Reads every answer waiting; returns true when one for `frame` completed the barrier.
+  void takeAnswers(std::int64_t presenting) {
+    for (;;) {
+      std::array<char, 64> id{};
+      const int idBytes = zmq_recv(answers.get(), id.data(), id.size(), ZMQ_DONTWAIT);
+      if (idBytes < 0) return;
+      int more = 0;
+      std::size_t moreSize = sizeof more;
+      zmq_getsockopt(answers.get(), ZMQ_RCVMORE, &more, &moreSize);
+      if (!more) {
+        ++figures.malformed;
+        continue;
+      }
+      std::array<std::byte, kMaxLockMessageBytes + 1> bytes{};
+      const int n = zmq_recv(answers.get(), bytes.data(), bytes.size(), ZMQ_DONTWAIT);
+      if (n < 0) continue;
+      // Drop any further parts of a message with more than two.
+      zmq_getsockopt(answers.get(), ZMQ_RCVMORE, &more, &moreSize);
+      while (more) {
+        std::array<char, 16> rest{};
+        (void)zmq_recv(answers.get(), rest.data(), rest.size(), ZMQ_DONTWAIT);
+        zmq_getsockopt(answers.get(), ZMQ_RCVMORE, &more, &moreSize);
+        ++figures.malformed;
+      }
+      const auto size = std::min<std::size_t>(static_cast<std::size_t>(n), bytes.size());
+      auto ready = decodeReady(std::span<const std::byte>(bytes.data(), size));
+      if (!ready) {
+        if (figures.malformed++ == 0) log::warn(kLogLock, "{}", ready.error().message());
+        continue;
+      }
+      const std::string name = ready->nodeName();
+      auto [it, isNew] = followers.try_emplace(name);
+      Follower& f = it->second;
+      if (isNew) {
+        log::info(kLogLock, "follower '{}' joined at frame {}", name, ready->frame);
+        ++figures.followersKnown;
+      } else if (!f.inBarrier) {
+        log::info(kLogLock, "follower '{}' is back in the barrier at frame {}", name, ready->frame);
+        ++figures.followersRejoined;
+      }
+      f.inBarrier = true;
+      f.missed = 0;
+      f.clockOffsetNs = ready->clockOffsetNs;
+      f.skipped = ready->skipped;
+      if (ready->frame >= 0 && ready->frame < presenting) ++figures.lateAnswers;
+      f.lastReady = std::max(f.lastReady, ready->frame);
+      figures.maxClockOffsetUs = std::max(figures.maxClockOffsetUs, std::abs(ready->clockOffsetNs) / 1000);
+    }
+  }
+
+  [[nodiscard]] bool allReady(std::int64_t frame) const {
+    return std::all_of(followers.begin(), followers.end(),
+                       [frame](const auto& f) { return !f.second.inBarrier || f.second.lastReady >= frame; });
+  }
+
+  void publishFrame(const FrameContext& frame) {
+    FrameMessage m;
+    m.frame = frame.frame;
+    m.showTimeNs = frame.time.count();
+    m.sentNs = shared->now().count();
+    m.state = captureLockedState(show);
+    send(pub.get(), encode(m, buffer));
+  }
+
+  void barrier(std::int64_t frame) {
+    const SystemClock wall;
+    const Nanos start = wall.now();
+    const Nanos deadline = start + std::chrono::milliseconds(spec.timeoutMs);
+    takeAnswers(frame);
+    while (!allReady(frame)) {
+      const Nanos left = deadline - wall.now();
+      if (left <= Nanos{0}) break;
+      zmq_pollitem_t item{answers.get(), 0, ZMQ_POLLIN, 0};
+      const auto ms = std::max<long>(1, static_cast<long>(std::chrono::ceil<std::chrono::milliseconds>(left).count()));
+      if (zmq_poll(&item, 1, ms) < 0 && zmq_errno() != EINTR) break;
+      takeAnswers(frame);
+    }
+    barrierWait.add(millis(wall.now() - start));
+    bool complete = true;
+    for (auto& [name, f] : followers) {
+      if (!f.inBarrier || f.lastReady >= frame) continue;
+      complete = false;
+      if (++f.missed >= spec.dropAfter) {
+        f.inBarrier = false;
+        ++figures.followersDropped;
+        log::warn(kLogLock, "follower '{}' left the barrier: no answer for {} frames (last frame {}); the others go on",
+                  name, f.missed, f.lastReady);
+      }
+    }
+    if (!complete) ++figures.barrierTimeouts;
+    PresentMessage present{frame};
+    send(pub.get(), encode(present, buffer));
+  }
+
+  // ---- Follower ----
+
+  void sayReady(std::int64_t frame) {
+    ReadyMessage m;
+    m.frame = frame;
+    m.skipped = figures.skipped;
+    m.clockOffsetNs = probe ? probe->offset().count() : 0;
+    m.setNodeName(spec.node);
+    figures.clockOffsetUs = m.clockOffsetNs / 1000;
+    figures.maxClockOffsetUsSeen = std::max(figures.maxClockOffsetUsSeen, std::abs(figures.clockOffsetUs));
+    send(answers.get(), encode(m, buffer));
+  }
+
+  /// Reads everything the leader sent; returns the newest "present" number seen (or -1).
+  std::int64_t takeLeaderMessages() {
+    std::int64_t presented = -1;
+    for (;;) {
+      std::array<std::byte, kMaxLockMessageBytes + 1> bytes{};
+      const int n = zmq_recv(pub.get(), bytes.data(), bytes.size(), ZMQ_DONTWAIT);
+      if (n < 0) break;
+      const std::span<const std::byte> message(bytes.data(),
+                                               std::min<std::size_t>(static_cast<std::size_t>(n), bytes.size()));
+      auto kind = peekKind(message);
+      if (!kind) {
+        if (figures.malformed++ == 0) log::warn(kLogLock, "{}", kind.error().message());
+        continue;
+      }
+      heard();
+      switch (*kind) {
+        case LockMessageKind::kFrame:
+          if (auto f = decodeFrame(message)) {
+            delay.add(millis(shared->now() - Nanos{f->sentNs}));
+            // A newer frame replaces one not drawn yet: nextFrame() counts the gap as skipped.
+            if (f->frame > current && (!pending || f->frame > pending->frame)) pending = *f;
+          } else {
+            ++figures.malformed;
+          }
+          break;
+        case LockMessageKind::kPresent:
+          if (auto p = decodePresent(message)) {
+            presented = std::max(presented, p->frame);
+            newestPresented = std::max(newestPresented, p->frame);
+          }
+          break;
+        case LockMessageKind::kBye: byeSeen = true; break;
+        case LockMessageKind::kReady:
+          ++figures.malformed;  // followers do not talk to each other
+          break;
+      }
+    }
+    return presented;
+  }
+
+  void heard() {
+    const SystemClock wall;
+    lastHeard = wall.now();
+    if (!figures.leaderPresent) {
+      if (figures.leaderLost > 0) {
+        // A restarted leader counts from its own start: take its frames from here on.
+        log::info(kLogLock, "the leader is back");
+        current = -1;
+        newestPresented = -1;
+      }
+      figures.leaderPresent = true;
+    }
+  }
+
+  void checkLeader() {
+    const SystemClock wall;
+    const Nanos now = wall.now();
+    if (lastHeard.count() < 0) lastHeard = now;  // counting from the start
+    if (!figures.leaderPresent && figures.leaderLost == 0 && !waitingReported &&
+        now - lastHeard > std::chrono::milliseconds(spec.leaderTimeoutMs)) {
+      waitingReported = true;
+      log::warn(kLogLock, "no leader at {} port {} yet; waiting for it", spec.leader, spec.port);
+    }
+    if (figures.leaderPresent && now - lastHeard > std::chrono::milliseconds(spec.leaderTimeoutMs)) {
+      figures.leaderPresent = false;
+      ++figures.leaderLost;
+      joined = false;  // say hello again, so that a restarted leader counts this follower
+      log::warn(kLogLock, "the leader at {} is lost: nothing for {} ms; holding frame {} until it is back", spec.leader,
+                spec.leaderTimeoutMs, current);
+    }
+    // Until the first frame, say hello every 100 ms: the leader counts who is here before it
+    // starts, and knows our SUB socket is connected once we heard its beacon.
+    if (!joined && figures.leaderPresent &&
+        (lastHello.count() < 0 || now - lastHello > std::chrono::milliseconds(100))) {
+      lastHello = now;
+      sayReady(-1);
+    }
+  }
+
+  Result<std::optional<GatedFrame>> nextFrame(runtime::EventLoop& loop, Nanos patience) {
+    const SystemClock wall;
+    const Nanos deadline = wall.now() + patience;
+    for (;;) {
+      (void)takeLeaderMessages();
+      checkLeader();
+      if (byeSeen && !pending) return GatedFrame{current, Nanos{0}, true};
+      if (pending) {
+        const FrameMessage& f = *pending;
+        if (current >= 0 && f.frame > current + 1) figures.skipped += f.frame - current - 1;
+        current = f.frame;
+        joined = true;
+        return GatedFrame{f.frame, Nanos{f.showTimeNs}, false};
+      }
+      const Nanos left = deadline - wall.now();
+      if (left <= Nanos{0}) return std::optional<GatedFrame>{};
+      // Poll the SUB socket in short slices and serve the event loop between them (signals,
+      // wake-ups), so a follower waiting for its leader still stops when told to.
+      zmq_pollitem_t item{pub.get(), 0, ZMQ_POLLIN, 0};
+      (void)zmq_poll(&item, 1, std::min<long>(5, std::max<long>(1, static_cast<long>(left.count() / 1'000'000))));
+      if (auto r = loop.dispatch(Nanos{0}); !r) return std::unexpected(r.error());
+    }
+  }
+
+  void beforeDrawFollower() {
+    if (!pending) return;
+    applyLockedState(pending->state, show);
+    pending.reset();
+  }
+
+  void afterDrawFollower(std::int64_t frame) {
+    sayReady(frame);
+    ++figures.framesDrawn;
+    if (figures.firstFrame < 0) figures.firstFrame = frame;
+    figures.lastFrame = frame;
+    // FNV-1a over the frame numbers in order: two nodes that drew the same frames agree.
+    std::uint64_t h = figures.frameChecksum == 0 ? 1469598103934665603ULL : figures.frameChecksum;
+    for (int i = 0; i < 8; ++i) {
+      h ^= static_cast<std::uint64_t>(frame >> (8 * i)) & 0xffU;
+      h *= 1099511628211ULL;
+    }
+    figures.frameChecksum = h;
+    const SystemClock wall;
+    const Nanos deadline = wall.now() + std::chrono::milliseconds(spec.leaderTimeoutMs);
+    for (;;) {
+      const std::int64_t presented = takeLeaderMessages();
+      if (presented >= frame) break;
+      if (byeSeen || (pending && pending->frame > frame)) {
+        // The leader went on without our answer (it was late, or its "present" is lost).
+        ++figures.presentsMissed;
+        break;
+      }
+      const Nanos left = deadline - wall.now();
+      if (left <= Nanos{0}) {
+        ++figures.presentsMissed;
+        break;
+      }
+      zmq_pollitem_t item{pub.get(), 0, ZMQ_POLLIN, 0};
+      (void)zmq_poll(&item, 1, std::max<long>(1, static_cast<long>(left.count() / 1'000'000)));
+    }
+    // Skew: the newest frame the leader presented minus the one this node presents (0 in step).
+    figures.maxSkewFrames = std::max(figures.maxSkewFrames, newestPresented - frame);
+  }
+};
+
+FrameLock::FrameLock(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+FrameLock::~FrameLock() = default;
+
+Result<std::unique_ptr<FrameLock>> FrameLock::create(const LockSpec& spec, const Clock& clock, runtime::Show& show) {
+  if (spec.role == LockRole::kOff) return fail(Errc::kInvalidArgument, "frame lock: the role is off");
+  auto impl = std::make_unique<Impl>(spec, clock, show);
+  impl->figures.leader = impl->isLeader();
+  impl->figures.node = spec.node;
+  impl->context.reset(zmq_ctx_new());
+  if (!impl->context) return fail(Errc::kUnavailable, "frame lock: cannot start ZeroMQ");
+  const bool leader = impl->isLeader();
+  auto pub = makeSocket(impl->context.get(), leader ? ZMQ_PUB : ZMQ_SUB, leader ? "publishing" : "subscribing");
+  if (!pub) return std::unexpected(pub.error());
+  auto answers = makeSocket(impl->context.get(), leader ? ZMQ_ROUTER : ZMQ_DEALER, "answer");
+  if (!answers) return std::unexpected(answers.error());
+  impl->pub = std::move(*pub);
+  impl->answers = std::move(*answers);
+  if (leader) {
+    const int handover = 1;  // a restarted follower with the same name takes its place over
+    zmq_setsockopt(impl->answers.get(), ZMQ_ROUTER_HANDOVER, &handover, sizeof handover);
+    for (auto [socket, port] : {std::pair{impl->pub.get(), spec.port}, std::pair{impl->answers.get(), spec.port + 1}}) {
+      const std::string at = endpoint(spec.listen, port);
+      if (zmq_bind(socket, at.c_str()) != 0) {
+        return failf(Errc::kUnavailable, "frame lock: cannot listen on {}: {} (another leader on this node?)", at,
+                     zmq_strerror(zmq_errno()));
+      }
+    }
+  } else {
+    zmq_setsockopt(impl->pub.get(), ZMQ_SUBSCRIBE, "", 0);
+    zmq_setsockopt(impl->answers.get(), ZMQ_ROUTING_ID, spec.node.data(), spec.node.size());
+    const int reconnect = 100;  // ms: a restarted leader is found again quickly
+    zmq_setsockopt(impl->pub.get(), ZMQ_RECONNECT_IVL, &reconnect, sizeof reconnect);
+    zmq_setsockopt(impl->answers.get(), ZMQ_RECONNECT_IVL, &reconnect, sizeof reconnect);
+    for (auto [socket, port] : {std::pair{impl->pub.get(), spec.port}, std::pair{impl->answers.get(), spec.port + 1}}) {
+      const std::string at = endpoint(spec.leader, port);
+      if (zmq_connect(socket, at.c_str()) != 0) {
+        return failf(Errc::kInvalidArgument, "frame lock: cannot connect to {}: {}", at, zmq_strerror(zmq_errno()));
+      }
+    }
+  }
+  return std::unique_ptr<FrameLock>(new FrameLock(std::move(impl)));
+}
+
+bool FrameLock::leader() const { return impl_->isLeader(); }
+
+void FrameLock::setClockProbe(const LockClockProbe* probe) { impl_->probe = probe; }
+
+void FrameLock::setSharedClock(const Clock& clock) { impl_->shared = &clock; }
+
+std::int64_t FrameLock::awaitFollowers(runtime::EventLoop& loop) {
+  Impl& d = *impl_;
+  const SystemClock wall;
+  const Nanos deadline = wall.now() + std::chrono::milliseconds(d.spec.joinTimeoutMs);
+  Nanos lastBeacon{-1};
+  while (static_cast<std::int64_t>(d.followers.size()) < d.spec.followers && wall.now() < deadline) {
+    if (lastBeacon.count() < 0 || wall.now() - lastBeacon > std::chrono::milliseconds(50)) {
+      // A beacon (present -1): a follower that hears it knows its SUB socket is connected.
+      lastBeacon = wall.now();
+      d.send(d.pub.get(), encode(PresentMessage{-1}, d.buffer));
+    }
+    zmq_pollitem_t item{d.answers.get(), 0, ZMQ_POLLIN, 0};
+    (void)zmq_poll(&item, 1, 10);
+    d.takeAnswers(0);
+    if (!loop.dispatch(Nanos{0})) break;
+  }
+  const auto joined = static_cast<std::int64_t>(d.followers.size());
+  if (joined < d.spec.followers) {
+    log::warn(kLogLock,
+              "{} of {} followers joined within {} ms; starting without the others (they join when they come)", joined,
+              d.spec.followers, d.spec.joinTimeoutMs);
+  }
+  return joined;
+}
+
+void FrameLock::sayBye(std::int64_t frame) {
+  Impl& d = *impl_;
+  if (!d.isLeader()) return;
+  d.send(d.pub.get(), encode(ByeMessage{frame}, d.buffer));
+}
+
+Result<void> FrameLock::beforeDraw(const FrameContext& frame) {
+  if (impl_->isLeader()) {
+    impl_->publishFrame(frame);
+  } else {
+    impl_->beforeDrawFollower();
+  }
+  return {};
+}
+
+Result<void> FrameLock::afterDraw(const FrameContext& frame, render::Output& output) {
+  (void)output;
+  if (impl_->isLeader()) {
+    impl_->barrier(frame.frame);
+    if (frame.last) sayBye(frame.frame);
+  } else {
+    impl_->afterDrawFollower(frame.frame);
+  }
+  return {};
+}
+
+bool FrameLock::wantsStop() const { return !impl_->isLeader() && impl_->byeSeen && !impl_->pending; }
+
+Result<std::optional<GatedFrame>> FrameLock::nextFrame(runtime::EventLoop& loop, Nanos patience) {
+  if (impl_->isLeader()) return fail(Errc::kInternal, "frame lock: the leader paces itself; it has no gate");
+  return impl_->nextFrame(loop, patience);
+}
+
+FrameLockFigures FrameLock::figures() const {
+  FrameLockFigures f = impl_->figures;
+  f.followers = static_cast<std::int64_t>(std::count_if(impl_->followers.begin(), impl_->followers.end(),
+                                                        [](const auto& x) { return x.second.inBarrier; }));
+  f.barrierWaitP50Ms = impl_->barrierWait.median();
+  f.barrierWaitMaxMs = impl_->barrierWait.max();
+  f.delayP50Ms = impl_->delay.median();
+  f.delayMaxMs = impl_->delay.max();
+  return f;
+}
+
+std::string FrameLock::describe() const {
+  const FrameLockFigures f = figures();
+  if (f.leader) {
+    return fmt::format(
+        "frame lock: leader '{}': {} followers in the barrier ({} known), {} frames presented without every answer, "
+        "{} dropped, {} rejoined, {} late answers, barrier wait median {:.3f} ms max {:.3f} ms, largest follower "
+        "clock offset {} us, {} malformed messages",
+        f.node, f.followers, f.followersKnown, f.barrierTimeouts, f.followersDropped, f.followersRejoined,
+        f.lateAnswers, f.barrierWaitP50Ms, f.barrierWaitMaxMs, f.maxClockOffsetUs, f.malformed);
+  }
+  return fmt::format(
+      "frame lock: follower '{}': drew {} frames, {}..{}, checksum {:016x}, {} skipped, {} presented without the "
+      "leader's word, skew at most {} frames, leader lost {} times, clock offset {} us (largest {} us), delay median "
+      "{:.3f} ms max {:.3f} ms, {} malformed messages",
+      f.node, f.framesDrawn, f.firstFrame, f.lastFrame, f.frameChecksum, f.skipped, f.presentsMissed, f.maxSkewFrames,
+      f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs, f.malformed);
+}
+
+}  // namespace basalt::kiosk

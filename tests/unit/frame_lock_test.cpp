@@ -1,0 +1,426 @@
+// Frame-locked nodes (kiosk/lock_protocol.h, kiosk/frame_lock.h): the wire format, and a leader
+// with followers over ZeroMQ on loopback, each node on its own thread, without rendering.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <thread>
+#include <vector>
+
+#include "kiosk/frame_lock.h"
+#include "kiosk/lock_protocol.h"
+#include "kiosk/manifest.h"
+#include "render/output.h"
+#include "runtime/event_loop.h"
+#include "runtime/show/show.h"
+
+namespace basalt::kiosk {
+namespace {
+
+FrameMessage sampleFrame() {
+  FrameMessage m;
+  m.frame = 1234;
+  m.showTimeNs = 20'566'666'666;
+  m.sentNs = 987'654'321;
+  runtime::Show show;
+  show.rotateGlobal({10, 20, 30});
+  show.translateLocal({1, 2, 3});
+  show.motion().globalFreeRun = true;
+  show.motion().framesLeft = 7;
+  show.view().perspective = 2.5f;
+  show.viewer().position = {4, 1.7f, -3};
+  show.viewer().rotation = {0, 45, 0};
+  m.state = captureLockedState(show);
+  return m;
+}
+
+std::span<const std::byte> bytesOf(const LockBuffer& b, std::size_t n) { return {b.data(), n}; }
+
+// Makes sure every message survives encoding unchanged. Example failure: a field written in one
+// order and read in another.
+TEST(LockProtocol, MessagesRoundTrip) {
+  LockBuffer b{};
+  const FrameMessage frame = sampleFrame();
+  const std::size_t n = encode(frame, b);
+  EXPECT_EQ(n, kFrameMessageBytes);
+  auto back = decodeFrame(bytesOf(b, n));
+  ASSERT_TRUE(back) << back.error().message();
+  EXPECT_EQ(*back, frame);
+
+  runtime::Show follower;
+  applyLockedState(back->state, follower);
+  EXPECT_EQ(captureLockedState(follower), frame.state);
+
+  ReadyMessage ready;
+  ready.frame = -1;
+  ready.skipped = 3;
+  ready.clockOffsetNs = -42'000;
+  ready.setNodeName("facet-north");
+  auto r = decodeReady(bytesOf(b, encode(ready, b)));
+  ASSERT_TRUE(r) << r.error().message();
+  EXPECT_EQ(*r, ready);
+  EXPECT_EQ(r->nodeName(), "facet-north");
+
+  auto p = decodePresent(bytesOf(b, encode(PresentMessage{77}, b)));
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->frame, 77);
+  auto bye = decodeBye(bytesOf(b, encode(ByeMessage{99}, b)));
+  ASSERT_TRUE(bye);
+  EXPECT_EQ(bye->frame, 99);
+}
+
+// Makes sure a truncated, lengthened or foreign message is rejected with the reason, never read
+// past its end. Example failure: a short packet read as a frame with garbage state.
+TEST(LockProtocol, MalformedMessagesAreRejectedWithTheReason) {
+  LockBuffer b{};
+  const std::size_t n = encode(sampleFrame(), b);
+  for (std::size_t len = 0; len < n; ++len) {
+    auto d = decodeFrame(bytesOf(b, len));
+    ASSERT_FALSE(d) << "accepted " << len << " bytes";
+    if (len >= kLockHeaderBytes) {
+      EXPECT_NE(d.error().message().find("truncated"), std::string::npos) << len;
+    }
+  }
+  std::array<std::byte, kFrameMessageBytes + 1> longer{};
+  std::memcpy(longer.data(), b.data(), n);
+  auto tooLong = decodeFrame(longer);
+  ASSERT_FALSE(tooLong);
+  EXPECT_NE(tooLong.error().message().find("this one has 317"), std::string::npos) << tooLong.error().message();
+
+  LockBuffer bad = b;
+  bad[0] = std::byte{'X'};
+  auto magic = decodeFrame(bytesOf(bad, n));
+  ASSERT_FALSE(magic);
+  EXPECT_NE(magic.error().message().find("magic"), std::string::npos);
+
+  bad = b;
+  bad[4] = std::byte{2};
+  auto version = decodeFrame(bytesOf(bad, n));
+  ASSERT_FALSE(version);
+  EXPECT_NE(version.error().message().find("version 2"), std::string::npos);
+
+  bad = b;
+  bad[5] = std::byte{9};
+  auto kind = peekKind(bytesOf(bad, n));
+  ASSERT_FALSE(kind);
+  EXPECT_NE(kind.error().message().find("unknown kind 9"), std::string::npos);
+
+  bad = b;
+  bad[6] = std::byte{1};
+  EXPECT_FALSE(peekKind(bytesOf(bad, n)));
+
+  // A present where a frame was expected.
+  const std::size_t pn = encode(PresentMessage{5}, bad);
+  auto wrong = decodeFrame(bytesOf(bad, pn));
+  ASSERT_FALSE(wrong);
+  EXPECT_NE(wrong.error().message().find("expected a 'frame' message, got 'present'"), std::string::npos);
+
+  // Numbers that are not finite.
+  FrameMessage nan = sampleFrame();
+  nan.state.perspective = std::numeric_limits<float>::quiet_NaN();
+  auto notFinite = decodeFrame(bytesOf(bad, encode(nan, bad)));
+  ASSERT_FALSE(notFinite);
+  EXPECT_NE(notFinite.error().message().find("not finite"), std::string::npos);
+
+  FrameMessage negative = sampleFrame();
+  negative.frame = -3;
+  EXPECT_FALSE(decodeFrame(bytesOf(bad, encode(negative, bad))));
+}
+
+// ---- The manifest's [lock] ----
+
+struct ManifestReport {
+  std::optional<Manifest> manifest;
+  Diagnostics diagnostics;
+};
+
+ManifestReport readLockManifest(const std::string& text) {
+  ManifestReport report;
+  report.manifest =
+      readManifestText(text, std::filesystem::temp_directory_path() / "lock-show" / "show.toml", report.diagnostics);
+  return report;
+}
+
+bool mentions(const ManifestReport& report, int line, std::string_view text) {
+  for (const Diagnostic& d : report.diagnostics.items()) {
+    if (d.line == line && d.message.find(text) != std::string::npos) return true;
+  }
+  return false;
+}
+
+// Makes sure the [lock] keys reach the spec and mistakes name their line. Example failure: a
+// follower without a leader address starts and waits for ever.
+TEST(LockManifest, KeysAreReadAndMistakesNamed) {
+  auto good = readLockManifest(
+      "[lock]\nrole = \"leader\"\nnode = \"a\"\nport = 6000\nfollowers = 2\ntimeout_ms = 8\n"
+      "drop_after = 5\nclock = false\n");
+  ASSERT_TRUE(good.manifest) << good.diagnostics.format();
+  const LockSpec& l = good.manifest->lock;
+  EXPECT_EQ(l.role, LockRole::kLeader);
+  EXPECT_EQ(l.node, "a");
+  EXPECT_EQ(l.port, 6000);
+  EXPECT_EQ(l.followers, 2);
+  EXPECT_EQ(l.timeoutMs, 8);
+  EXPECT_EQ(l.dropAfter, 5);
+  EXPECT_FALSE(l.clock);
+
+  auto follower = readLockManifest("[show]\nname = \"x\"\n\n[lock]\nrole = \"follower\"\n");
+  EXPECT_FALSE(follower.manifest);
+  EXPECT_TRUE(mentions(follower, 4, "a follower needs leader")) << follower.diagnostics.format();
+
+  auto role = readLockManifest("[lock]\nrole = \"boss\"\nleader = \"10.0.0.1\"\n");
+  EXPECT_FALSE(role.manifest);
+  EXPECT_TRUE(mentions(role, 2, "lock.role"));
+
+  auto typo = readLockManifest("[lock]\nrole = \"follower\"\nleader = \"10.0.0.1\"\ntimeout = 5\n");
+  EXPECT_FALSE(typo.manifest);
+  EXPECT_TRUE(mentions(typo, 4, "timeout_ms"));
+
+  auto port = readLockManifest("[lock]\nrole = \"leader\"\nport = 70000\n");
+  EXPECT_FALSE(port.manifest);
+  EXPECT_TRUE(mentions(port, 3, "lock.port"));
+}
+
+// ---- Leader and followers on loopback ----
+
+class NullOutput final : public render::Output {
+ public:
+  [[nodiscard]] std::string_view kind() const override { return "null"; }
+  [[nodiscard]] render::Size size() const override { return {4, 4}; }
+  [[nodiscard]] std::string describe() const override { return "null"; }
+  [[nodiscard]] Result<void> beginFrame() override { return {}; }
+  [[nodiscard]] Result<void> present() override { return {}; }
+};
+
+int freePortPair() {
+  // Ports from the pid keep parallel test processes apart; a clash fails at bind with a message.
+  return 20000 + static_cast<int>(::getpid() % 2000) * 8;
+}
+
+LockSpec leaderSpec(int port, int followers, int timeoutMs) {
+  LockSpec s;
+  s.role = LockRole::kLeader;
+  s.node = "leader";
+  s.listen = "127.0.0.1";
+  s.port = port;
+  s.followers = followers;
+  s.joinTimeoutMs = 10000;
+  s.timeoutMs = timeoutMs;
+  s.dropAfter = 3;
+  return s;
+}
+
+LockSpec followerSpec(int port, std::string name, int leaderTimeoutMs = 2000) {
+  LockSpec s;
+  s.role = LockRole::kFollower;
+  s.node = std::move(name);
+  s.leader = "127.0.0.1";
+  s.port = port;
+  s.leaderTimeoutMs = leaderTimeoutMs;
+  return s;
+}
+
+/// One follower node on its own thread: draws the frames its gate gives until the leader says
+/// bye, or `stopAfter` is drawn (a follower killed mid-show).
+struct FollowerNode {
+  std::vector<std::int64_t> frames;
+  std::vector<Mat4> globals;  // the show state drawn with each frame
+  FrameLockFigures figures;
+  std::string failure;
+
+  void run(const LockSpec& spec, std::int64_t stopAfter = -1) {
+    SystemClock clock;
+    auto loop = runtime::EventLoop::create(clock);
+    runtime::Show show;
+    auto lock = FrameLock::create(spec, clock, show);
+    if (!loop || !lock) {
+      failure = "cannot create the follower";
+      return;
+    }
+    NullOutput output;
+    const auto giveUp = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (std::chrono::steady_clock::now() < giveUp) {
+      auto next = (*lock)->nextFrame(**loop, std::chrono::milliseconds(100));
+      if (!next) {
+        failure = next.error().message();
+        break;
+      }
+      if (!*next) continue;
+      if ((*next)->end) break;
+      FrameContext context{(*next)->frame, (*next)->time, false};
+      EXPECT_TRUE((*lock)->beforeDraw(context));
+      frames.push_back(context.frame);
+      globals.push_back(show.position().global);
+      EXPECT_TRUE((*lock)->afterDraw(context, output));
+      if (stopAfter >= 0 && context.frame >= stopAfter) break;
+    }
+    figures = (*lock)->figures();
+  }
+};
+
+struct LeaderNode {
+  std::vector<Mat4> globals;
+  FrameLockFigures figures;
+  std::int64_t joined = 0;
+  std::atomic<std::int64_t> frame{-1};
+  std::string failure;
+
+  void run(const LockSpec& spec, std::int64_t frames, std::chrono::microseconds pause) {
+    SystemClock clock;
+    auto loop = runtime::EventLoop::create(clock);
+    runtime::Show show;
+    auto lock = FrameLock::create(spec, clock, show);
+    if (!loop || !lock) {
+      failure = lock ? "no event loop" : lock.error().message();
+      return;
+    }
+    NullOutput output;
+    joined = (*lock)->awaitFollowers(**loop);
+    for (std::int64_t f = 0; f < frames; ++f) {
+      show.rotateGlobal({1.0f, 0.5f, 0.25f});  // the show moves every frame
+      FrameContext context{f, std::chrono::milliseconds(16) * f, f + 1 == frames};
+      EXPECT_TRUE((*lock)->beforeDraw(context));
+      globals.push_back(show.position().global);
+      EXPECT_TRUE((*lock)->afterDraw(context, output));
+      frame = f;
+      std::this_thread::sleep_for(pause);
+    }
+    figures = (*lock)->figures();
+  }
+};
+
+bool contiguous(const std::vector<std::int64_t>& frames) {
+  for (std::size_t i = 1; i < frames.size(); ++i) {
+    if (frames[i] != frames[i - 1] + 1) return false;
+  }
+  return true;
+}
+
+// Makes sure two followers draw exactly the leader's frames, every one, with the leader's show
+// state, and that the leader waited for both each time. Example failure: a follower that draws
+// its own frame count, or state applied one frame late.
+TEST(FrameLock, TwoFollowersDrawEveryLeaderFrameWithItsState) {
+  const int port = freePortPair();
+  constexpr std::int64_t kFrames = 300;
+  LeaderNode leader;
+  FollowerNode a;
+  FollowerNode b;
+  std::thread ta([&] { a.run(followerSpec(port, "a")); });
+  std::thread tb([&] { b.run(followerSpec(port, "b")); });
+  leader.run(leaderSpec(port, 2, 2000), kFrames, std::chrono::microseconds(0));
+  ta.join();
+  tb.join();
+  ASSERT_EQ(leader.failure, "");
+  ASSERT_EQ(a.failure, "");
+  ASSERT_EQ(b.failure, "");
+  EXPECT_EQ(leader.joined, 2);
+  for (const FollowerNode* f : {&a, &b}) {
+    ASSERT_EQ(f->frames.size(), static_cast<std::size_t>(kFrames));
+    EXPECT_EQ(f->frames.front(), 0);
+    EXPECT_TRUE(contiguous(f->frames));
+    EXPECT_EQ(f->globals, leader.globals);
+    EXPECT_EQ(f->figures.skipped, 0);
+    EXPECT_EQ(f->figures.presentsMissed, 0);
+    EXPECT_EQ(f->figures.malformed, 0);
+    EXPECT_EQ(f->figures.maxSkewFrames, 0);
+  }
+  EXPECT_EQ(a.figures.frameChecksum, b.figures.frameChecksum);
+  EXPECT_EQ(leader.figures.barrierTimeouts, 0);
+  EXPECT_EQ(leader.figures.followers, 2);
+}
+
+// Makes sure a follower that dies leaves the barrier without stopping the others, and is back in
+// it when it starts again. Example failure: the leader waits for the dead follower for ever, or
+// the restarted one is never waited for again.
+TEST(FrameLock, AKilledFollowerLeavesAndRejoinsWithoutStoppingTheOthers) {
+  const int port = freePortPair() + 2;
+  constexpr std::int64_t kFrames = 400;
+  LeaderNode leader;
+  FollowerNode a;
+  FollowerNode killed;
+  FollowerNode restarted;
+  std::thread ta([&] { a.run(followerSpec(port, "a")); });
+  std::thread tb([&] {
+    killed.run(followerSpec(port, "b"), 100);
+    while (leader.frame.load() < 150) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    restarted.run(followerSpec(port, "b"));
+  });
+  leader.run(leaderSpec(port, 2, 50), kFrames, std::chrono::microseconds(2000));
+  ta.join();
+  tb.join();
+  ASSERT_EQ(leader.failure, "");
+  ASSERT_EQ(a.frames.size(), static_cast<std::size_t>(kFrames));
+  EXPECT_TRUE(contiguous(a.frames));
+  ASSERT_FALSE(killed.frames.empty());
+  EXPECT_EQ(killed.frames.back(), 100);
+  ASSERT_FALSE(restarted.frames.empty());
+  EXPECT_GE(restarted.frames.front(), 150);
+  EXPECT_EQ(restarted.frames.back(), kFrames - 1);
+  EXPECT_TRUE(contiguous(restarted.frames));
+  EXPECT_EQ(leader.figures.followersDropped, 1);
+  EXPECT_EQ(leader.figures.followersRejoined, 1);
+  EXPECT_EQ(leader.figures.followers, 2);
+  EXPECT_EQ(leader.figures.followersKnown, 2);
+}
+
+// Makes sure a follower whose leader vanishes (no bye) reports it and holds, and notices its
+// return. Example failure: the follower spins drawing nothing without a word, or exits.
+TEST(FrameLock, ALostLeaderIsReportedAndItsReturnNoticed) {
+  const int port = freePortPair() + 4;
+  SystemClock clock;
+  auto loop = runtime::EventLoop::create(clock);
+  auto leaderLoop = runtime::EventLoop::create(clock);  // one loop per thread
+  ASSERT_TRUE(loop);
+  ASSERT_TRUE(leaderLoop);
+  runtime::Show show;
+  auto follower = FrameLock::create(followerSpec(port, "a", 100), clock, show);
+  ASSERT_TRUE(follower);
+  NullOutput output;
+  std::vector<std::int64_t> drawn;
+  auto drawAvailable = [&](std::chrono::milliseconds wait) {
+    auto next = (*follower)->nextFrame(**loop, wait);
+    ASSERT_TRUE(next);
+    if (!*next || (*next)->end) return;
+    FrameContext c{(*next)->frame, (*next)->time, false};
+    EXPECT_TRUE((*follower)->beforeDraw(c));
+    EXPECT_TRUE((*follower)->afterDraw(c, output));
+    drawn.push_back(c.frame);
+  };
+  for (int round = 0; round < 2; ++round) {
+    runtime::Show leaderShow;
+    LockSpec spec = leaderSpec(port, 1, 500);
+    auto leader = FrameLock::create(spec, clock, leaderShow);
+    ASSERT_TRUE(leader) << leader.error().message();
+    std::thread t([&] {
+      for (int i = 0; i < 100 && drawn.size() < 5 * static_cast<std::size_t>(round + 1); ++i) {
+        drawAvailable(std::chrono::milliseconds(50));
+      }
+    });
+    EXPECT_EQ((*leader)->awaitFollowers(**leaderLoop), 1);
+    for (std::int64_t f = 0; f < 5; ++f) {
+      FrameContext c{std::int64_t{100} * round + f, Nanos{0}, false};
+      EXPECT_TRUE((*leader)->beforeDraw(c));
+      EXPECT_TRUE((*leader)->afterDraw(c, output));
+    }
+    t.join();
+    leader->reset();  // gone without a bye
+    // Nothing comes: the follower holds (no frame) and reports the leader lost once.
+    for (int i = 0; i < 4; ++i) {
+      auto next = (*follower)->nextFrame(**loop, std::chrono::milliseconds(60));
+      ASSERT_TRUE(next);
+      EXPECT_FALSE(*next);
+    }
+    const FrameLockFigures f = (*follower)->figures();
+    EXPECT_FALSE(f.leaderPresent);
+    EXPECT_EQ(f.leaderLost, round + 1);
+  }
+  ASSERT_EQ(drawn.size(), 10U);
+  EXPECT_EQ(drawn[5], 100);
+}
+
+}  // namespace
+}  // namespace basalt::kiosk
