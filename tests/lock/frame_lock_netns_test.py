@@ -1,0 +1,243 @@
+#!/usr/bin/env python3
+"""Frame-locked nodes as three real `basalt run` processes, each in its own network namespace.
+
+The leader's namespace is joined to each follower's by a veth pair (10.77.1.0/24 and
+10.77.2.0/24); every node plays a headless show with a [lock] table, and the test reads each
+node's summary line ("frame lock: ...") to check that all of them drew the same frame numbers.
+
+  frame_lock_netns_test.py BASALT steady    1 000 frames: every follower draws 0..999, none
+                                            skipped, the leader never presents without both
+  frame_lock_netns_test.py BASALT rejoin    a follower is killed (SIGKILL) and started again
+                                            while the show runs: the other follower misses no
+                                            frame, the restarted one draws a contiguous tail to
+                                            the last frame, the leader reports the drop and rejoin
+  frame_lock_netns_test.py BASALT netem     the same with 5 % loss and 20 ms delay on both links
+                                            (tc netem): the followers draw every frame; skew and
+                                            clock offset are printed
+
+Exits 77 (ctest: skipped) with the reason when not root, without `ip netns` or veth, or (netem)
+without the sch_netem qdisc. Example failure caught: a follower that draws its own frame count
+instead of the leader's, or a leader that stops when a follower dies.
+"""
+
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+SKIP = 77
+PREFIX = f"bl{os.getpid() % 100000}"
+LEADER, NODE_A, NODE_B = f"{PREFIX}l", f"{PREFIX}a", f"{PREFIX}b"
+PORT = 5760
+
+
+def sh(*args, check=True):
+    return subprocess.run(list(args), check=check, capture_output=True, text=True)
+
+
+def skip(reason):
+    print(f"SKIPPED: {reason}")
+    sys.exit(SKIP)
+
+
+def fnv(frames):
+    h = 1469598103934665603
+    for f in frames:
+        for i in range(8):
+            h ^= (f >> (8 * i)) & 0xFF
+            h = (h * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+    return h
+
+
+def setup_namespaces():
+    if os.geteuid() != 0:
+        skip("needs root for ip netns and veth links")
+    if not shutil.which("ip"):
+        skip("the ip command (iproute2) is not installed")
+    for ns in (LEADER, NODE_A, NODE_B):
+        r = sh("ip", "netns", "add", ns, check=False)
+        if r.returncode != 0:
+            teardown()
+            skip(f"ip netns add failed: {r.stderr.strip()}")
+        sh("ip", "-n", ns, "link", "set", "lo", "up")
+    for i, (ns, name) in enumerate(((NODE_A, "a"), (NODE_B, "b")), start=1):
+        ours, theirs = f"{PREFIX}L{name}", f"{PREFIX}{name}"
+        r = sh("ip", "link", "add", ours, "netns", LEADER, "type", "veth", "peer", "name", theirs, "netns", ns,
+               check=False)
+        if r.returncode != 0:
+            teardown()
+            skip(f"cannot make a veth pair: {r.stderr.strip()}")
+        sh("ip", "-n", LEADER, "addr", "add", f"10.77.{i}.1/24", "dev", ours)
+        sh("ip", "-n", ns, "addr", "add", f"10.77.{i}.2/24", "dev", theirs)
+        sh("ip", "-n", LEADER, "link", "set", ours, "up")
+        sh("ip", "-n", ns, "link", "set", theirs, "up")
+
+
+def add_netem():
+    """5 % loss and 20 ms delay both ways on both links, or skip with the reason."""
+    links = [(LEADER, f"{PREFIX}La"), (LEADER, f"{PREFIX}Lb"), (NODE_A, f"{PREFIX}a"), (NODE_B, f"{PREFIX}b")]
+    for ns, dev in links:
+        r = sh("ip", "netns", "exec", ns, "tc", "qdisc", "add", "dev", dev, "root", "netem", "delay", "20ms",
+               "loss", "5%", check=False)
+        if r.returncode != 0:
+            teardown()
+            skip(f"tc netem is not available here ({r.stderr.strip() or 'tc failed'}; the kernel needs sch_netem, "
+                 f"as Debian's stock kernel in the virtual lab has)")
+
+
+def teardown():
+    for ns in (LEADER, NODE_A, NODE_B):
+        sh("ip", "netns", "del", ns, check=False)
+
+
+def write_show(folder, lock):
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "show.toml"), "w") as f:
+        f.write('[show]\nname = "frame lock test"\nfps = 60\n\n[output]\nkind = "headless"\n\n[lock]\n' + lock)
+    return os.path.join(folder, "show.toml")
+
+
+def start(basalt, ns, show, *extra, tag):
+    out = open(os.path.join(os.path.dirname(show), f"{tag}.log"), "w")
+    cmd = ["ip", "netns", "exec", ns, basalt, "run", show, "--size", "64x48", "--output-dir",
+           os.path.dirname(show), "--no-resume", *extra]
+    return subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, text=True), out.name
+
+
+def summary(log):
+    text = open(log).read()
+    lines = re.findall(r"frame lock: (?:leader|follower) '[^']*': .*", text)
+    if not lines:
+        raise AssertionError(f"no frame-lock summary in {log}:\n{text[-3000:]}")
+    return lines[-1], text
+
+
+def follower_figures(line):
+    m = re.search(r"drew (\d+) frames, (-?\d+)\.\.(-?\d+), checksum ([0-9a-f]+), (\d+) skipped, (\d+) presented "
+                  r"without the leader's word, skew at most (-?\d+) frames, leader lost (\d+) times, clock offset "
+                  r"(-?\d+) us \(largest (-?\d+) us\)", line)
+    assert m, line
+    keys = ["drawn", "first", "last", "checksum", "skipped", "missed", "skew", "lost", "offset", "maxoffset"]
+    values = dict(zip(keys, m.groups()))
+    return {k: (int(v, 16) if k == "checksum" else int(v)) for k, v in values.items()}
+
+
+def leader_figures(line):
+    m = re.search(r"(\d+) followers in the barrier \((\d+) known\), (\d+) frames presented without every answer, "
+                  r"(\d+) dropped, (\d+) rejoined", line)
+    assert m, line
+    return dict(zip(["inbarrier", "known", "timeouts", "dropped", "rejoined"], map(int, m.groups())))
+
+
+def wait(proc, seconds, log):
+    try:
+        rc = proc.wait(timeout=seconds)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        raise AssertionError(f"{log} did not finish within {seconds} s:\n{open(log).read()[-3000:]}")
+    if rc != 0:
+        raise AssertionError(f"{log} exited with {rc}:\n{open(log).read()[-3000:]}")
+
+
+def leader_lock(timeout_ms, drop_after=3):
+    return (f'role = "leader"\nnode = "leader"\nport = {PORT}\nfollowers = 2\njoin_timeout_ms = 20000\n'
+            f'timeout_ms = {timeout_ms}\ndrop_after = {drop_after}\n')
+
+
+def follower_lock(name, net):
+    return f'role = "follower"\nnode = "{name}"\nleader = "10.77.{net}.1"\nport = {PORT}\nleader_timeout_ms = 3000\n'
+
+
+def run_steady(basalt, work, frames, timeout_ms, label):
+    lshow = write_show(os.path.join(work, "leader"), leader_lock(timeout_ms))
+    ashow = write_show(os.path.join(work, "a"), follower_lock("a", 1))
+    bshow = write_show(os.path.join(work, "b"), follower_lock("b", 2))
+    a, alog = start(basalt, NODE_A, ashow, tag="a")
+    b, blog = start(basalt, NODE_B, bshow, tag="b")
+    started = time.monotonic()
+    leader, llog = start(basalt, LEADER, lshow, "--frames", str(frames), tag="leader")
+    wait(leader, 600, llog)
+    elapsed = time.monotonic() - started
+    wait(a, 30, alog)
+    wait(b, 30, blog)
+    lline, _ = summary(llog)
+    lf = leader_figures(lline)
+    want = fnv(range(frames))
+    print(f"[{label}] leader: {lline}")
+    worst_skew, worst_offset = 0, 0
+    for name, log in (("a", alog), ("b", blog)):
+        line, _ = summary(log)
+        f = follower_figures(line)
+        print(f"[{label}] {name}: {line}")
+        assert f["drawn"] == frames and f["first"] == 0 and f["last"] == frames - 1, f
+        assert f["checksum"] == want, f"{name} drew other frame numbers than 0..{frames - 1}"
+        assert f["skipped"] == 0, f
+        worst_skew = max(worst_skew, f["skew"])
+        worst_offset = max(worst_offset, f["maxoffset"])
+    print(f"[{label}] {frames} frames in {elapsed:.1f} s; skew at most {worst_skew} frames; "
+          f"clock offset at most {worst_offset} us; leader presented {lf['timeouts']} frames without every answer")
+    return lf
+
+
+def run_rejoin(basalt, work):
+    frames = 600  # 10 s at 60 frames per second, paced
+    lshow = write_show(os.path.join(work, "leader"), leader_lock(100))
+    ashow = write_show(os.path.join(work, "a"), follower_lock("a", 1))
+    bshow = write_show(os.path.join(work, "b"), follower_lock("b", 2))
+    a, alog = start(basalt, NODE_A, ashow, tag="a")
+    b, blog = start(basalt, NODE_B, bshow, tag="b-first")
+    leader, llog = start(basalt, LEADER, lshow, "--frames", str(frames), "--realtime", tag="leader")
+    time.sleep(3)
+    b.send_signal(signal.SIGKILL)
+    b.wait()
+    time.sleep(2)
+    b2, b2log = start(basalt, NODE_B, bshow, tag="b-again")
+    wait(leader, 120, llog)
+    wait(a, 30, alog)
+    wait(b2, 30, b2log)
+    lline, _ = summary(llog)
+    lf = leader_figures(lline)
+    print(f"[rejoin] leader: {lline}")
+    aline, _ = summary(alog)
+    af = follower_figures(aline)
+    print(f"[rejoin] a: {aline}")
+    b2line, _ = summary(b2log)
+    bf = follower_figures(b2line)
+    print(f"[rejoin] b (restarted): {b2line}")
+    assert af["drawn"] == frames and af["checksum"] == fnv(range(frames)) and af["skipped"] == 0, af
+    assert bf["first"] > 0 and bf["last"] == frames - 1, bf
+    assert bf["checksum"] == fnv(range(bf["first"], frames)) and bf["skipped"] == 0, bf
+    assert lf["dropped"] >= 1 and lf["rejoined"] >= 1 and lf["inbarrier"] == 2, lf
+    print(f"[rejoin] the restarted follower came in at frame {bf['first']} and drew {bf['drawn']} frames to the end")
+
+
+def main():
+    basalt, mode = sys.argv[1], sys.argv[2]
+    setup_namespaces()
+    work = tempfile.mkdtemp(prefix="basalt-lock-")
+    try:
+        if mode == "steady":
+            lf = run_steady(basalt, work, 1000, 200, "steady")
+            assert lf["timeouts"] == 0 and lf["dropped"] == 0, lf
+        elif mode == "rejoin":
+            run_rejoin(basalt, work)
+        elif mode == "netem":
+            add_netem()
+            # A frame's answer takes two 20 ms hops: the barrier waits long enough for them.
+            run_steady(basalt, work, 1000, 250, "netem")
+        else:
+            print(f"unknown mode {mode}")
+            return 2
+    finally:
+        teardown()
+        shutil.rmtree(work, ignore_errors=True)
+    print("PASSED")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
