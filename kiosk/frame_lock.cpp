@@ -95,6 +95,9 @@ struct FrameLock::Impl {
   const Clock& clock;
   runtime::Show& show;
   const LockClockProbe* probe = nullptr;
+  std::function<void(const FrameLockFigures&)> publish;
+  Nanos lastPublished{-1};
+  bool publishNow = false;
   SystemClock ownClock;
   const Clock* shared = &ownClock;  // the clock every node reads alike (send and receive times)
   ZmqContext context;
@@ -301,7 +304,8 @@ struct FrameLock::Impl {
     if (figures.leaderPresent && now - lastHeard > std::chrono::milliseconds(spec.leaderTimeoutMs)) {
       figures.leaderPresent = false;
       ++figures.leaderLost;
-      joined = false;  // say hello again, so that a restarted leader counts this follower
+      joined = false;     // say hello again, so that a restarted leader counts this follower
+      publishNow = true;  // the status page says so while the picture holds
       log::warn(kLogLock, "the leader at {} is lost: nothing for {} ms; holding frame {} until it is back", spec.leader,
                 spec.leaderTimeoutMs, current);
     }
@@ -428,6 +432,20 @@ void FrameLock::setClockProbe(const LockClockProbe* probe) { impl_->probe = prob
 
 void FrameLock::setSharedClock(const Clock& clock) { impl_->shared = &clock; }
 
+void FrameLock::setPublisher(std::function<void(const FrameLockFigures&)> publish) {
+  impl_->publish = std::move(publish);
+}
+
+void FrameLock::afterPresent(const FrameContext& frame) {
+  (void)frame;
+  Impl& d = *impl_;
+  if (!d.publish) return;
+  const Nanos now = d.ownClock.now();
+  if (d.lastPublished.count() >= 0 && now - d.lastPublished < std::chrono::seconds(1)) return;
+  d.lastPublished = now;
+  d.publish(figures());
+}
+
 std::int64_t FrameLock::awaitFollowers(runtime::EventLoop& loop) {
   Impl& d = *impl_;
   const SystemClock wall;
@@ -483,7 +501,12 @@ bool FrameLock::wantsStop() const { return !impl_->isLeader() && impl_->byeSeen 
 
 Result<std::optional<GatedFrame>> FrameLock::nextFrame(runtime::EventLoop& loop, Nanos patience) {
   if (impl_->isLeader()) return fail(Errc::kInternal, "frame lock: the leader paces itself; it has no gate");
-  return impl_->nextFrame(loop, patience);
+  auto next = impl_->nextFrame(loop, patience);
+  if (impl_->publishNow && impl_->publish) {
+    impl_->publishNow = false;
+    impl_->publish(figures());
+  }
+  return next;
 }
 
 FrameLockFigures FrameLock::figures() const {

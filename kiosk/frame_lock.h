@@ -15,12 +15,14 @@
 /// lost and holds its last picture until the leader is back.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "kiosk/frame_loop.h"
+#include "kiosk/lock_figures.h"
 #include "kiosk/lock_protocol.h"
 #include "runtime/clock.h"
 #include "runtime/error.h"
@@ -28,38 +30,6 @@
 namespace basalt::kiosk {
 
 struct LockSpec;  // kiosk/manifest.h
-
-/// \brief The lock's figures, for the summary line, /health and /metrics.
-struct FrameLockFigures {
-  bool leader = false;
-  std::string node;
-  // Leader.
-  std::int64_t followers = 0;          ///< followers in the barrier now
-  std::int64_t followersKnown = 0;     ///< followers ever heard from
-  std::int64_t barrierTimeouts = 0;    ///< frames presented without every follower's answer
-  std::int64_t followersDropped = 0;   ///< times a follower left the barrier
-  std::int64_t followersRejoined = 0;  ///< times a dropped follower came back
-  std::int64_t lateAnswers = 0;        ///< answers for a frame already presented
-  double barrierWaitP50Ms = 0;         ///< time the leader waited for answers (median, max)
-  double barrierWaitMaxMs = 0;
-  std::int64_t maxClockOffsetUs = 0;  ///< largest |clock offset| a follower reported
-  // Follower.
-  std::int64_t framesDrawn = 0;
-  std::int64_t firstFrame = -1;  ///< the first and last leader frame this node drew
-  std::int64_t lastFrame = -1;
-  std::int64_t skipped = 0;         ///< leader frames passed over (fell behind, joined late)
-  std::int64_t presentsMissed = 0;  ///< frames presented without the leader's "present"
-  std::int64_t maxSkewFrames = 0;   ///< newest frame the leader presented minus this node's, largest
-  std::int64_t leaderLost = 0;      ///< times the leader went quiet
-  bool leaderPresent = false;
-  std::int64_t clockOffsetUs = 0;  ///< shared clock minus own clock at the last frame
-  std::int64_t maxClockOffsetUsSeen = 0;
-  std::uint64_t frameChecksum = 0;  ///< FNV-1a over the frame numbers drawn, in order
-  // Both.
-  std::int64_t malformed = 0;  ///< messages rejected (bad size, magic, version)
-  double delayP50Ms = 0;       ///< leader send -> follower receipt on the shared clock (followers)
-  double delayMaxMs = 0;
-};
 
 /// \brief Where the lock's shared clock reads (the network clock on followers), for the offset.
 class LockClockProbe {
@@ -95,10 +65,14 @@ class FrameLock final : public FrameParticipant, public FrameGate {
   /// leader's own monotonic clock (the default, what the leader serves), a follower's network
   /// clock. Borrowed.
   void setSharedClock(const Clock& clock);
+  /// \brief Called on the frame loop's thread with the figures after the first frame and then
+  /// about once a second (the kiosk hands them to the StatusBoard).
+  void setPublisher(std::function<void(const FrameLockFigures&)> publish);
 
   Result<void> beforeDraw(const FrameContext& frame) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
   [[nodiscard]] bool wantsStop() const override;
+  void afterPresent(const FrameContext& frame) override;
 
   Result<std::optional<GatedFrame>> nextFrame(runtime::EventLoop& loop, Nanos patience) override;
 

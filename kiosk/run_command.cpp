@@ -722,6 +722,7 @@ int runShow(const RunOptions& options) {
       lock->setClockProbe(&*clockProbe);
       lock->setSharedClock(*netClock);
     }
+    lock->setPublisher([&board](const FrameLockFigures& figures) { board.publishLock(figures); });
     frameLoop.addParticipant(*lock);
     if (lock->leader()) {
       const std::int64_t joined = lock->awaitFollowers(**loop);

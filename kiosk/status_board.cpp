@@ -88,6 +88,11 @@ void StatusBoard::publishPerformance(const runtime::PerformanceMeter& meter) {
   performance_ = meter;
 }
 
+void StatusBoard::publishLock(const FrameLockFigures& figures) {
+  std::lock_guard lock(mutex_);
+  lock_ = figures;
+}
+
 void StatusBoard::setNominalFps(double fps) {
   std::lock_guard lock(mutex_);
   nominalFps_ = fps;
@@ -189,6 +194,7 @@ StatusSnapshot StatusBoard::snapshot(WallTime now) const {
     s.reloadFailures = reloadFailures_;
     s.lastReload = lastReload_;
     s.performance = performance_;
+    s.lock = lock_;
   }
   if (s.show.schedule)
     s.show.nextScheduleChange = s.show.schedule->nextChange(showClock_ ? showClock_->wallNow() : now);

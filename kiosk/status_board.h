@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "kiosk/lock_figures.h"
 #include "kiosk/schedule.h"
 #include "runtime/bounded_queue.h"
 #include "runtime/clock.h"
@@ -94,6 +95,7 @@ struct StatusSnapshot {
   std::vector<log::Record> lastErrors;  ///< recent warnings and errors
   std::uint64_t errorsLogged = 0;
   runtime::PerformanceMeter performance;  ///< LAVA's meter, as last sampled (updates == 0: not yet)
+  std::optional<FrameLockFigures> lock;   ///< a frame-locked node's figures ([lock]); none otherwise
 };
 
 /// \brief A request from the control server to the frame loop, answered through `reply`.
@@ -158,6 +160,8 @@ class StatusBoard {
   void publishStreams(std::vector<StreamStatus> streams);
   /// \brief LAVA's performance meter (Show::performance()), after it took a new sample.
   void publishPerformance(const runtime::PerformanceMeter& meter);
+  /// \brief A frame-locked node's figures (kiosk/frame_lock.h).
+  void publishLock(const FrameLockFigures& figures);
 
   // ---- any thread ----
   [[nodiscard]] StatusSnapshot snapshot(WallTime now) const;
@@ -190,6 +194,7 @@ class StatusBoard {
   std::uint64_t inputDropped_ = 0;          // guarded by mutex_
   std::int64_t droppedFrames_ = 0;          // guarded by mutex_
   runtime::PerformanceMeter performance_;   // guarded by mutex_
+  std::optional<FrameLockFigures> lock_;    // guarded by mutex_
   ShowStatus show_;                         // guarded by mutex_
   std::vector<DeviceStatus> devices_;       // guarded by mutex_
   std::vector<StreamStatus> streams_;       // guarded by mutex_

@@ -79,6 +79,10 @@ std::string_view overallState(const StatusSnapshot& s) {
   for (const StreamStatus& st : s.streams) {
     if (st.state != "playing") return "degraded";
   }
+  // A frame-locked node: a follower without its leader, a leader missing a follower it knew.
+  if (s.lock && (s.lock->leader ? s.lock->followers < s.lock->followersKnown : !s.lock->leaderPresent)) {
+    return "degraded";
+  }
   return "ok";
 }
 
@@ -116,6 +120,19 @@ std::string healthJson(const StatusSnapshot& s) {
       "\"fps\": {:.2f}, \"primitives_per_second\": {:.0f}, \"sample_seconds\": {:.1f}, \"samples\": {}}},\n",
       m.triangles, m.lines, m.points, m.parts, m.facets, m.framesPerSecond, m.primitivesPerSecond,
       m.samplePeriodSeconds, m.updates);
+  if (const std::optional<FrameLockFigures>& l = s.lock) {
+    out += fmt::format(
+        "  \"lock\": {{\"role\": {}, \"node\": {}, \"followers\": {}, \"followers_known\": {}, "
+        "\"barrier_timeouts\": {}, \"followers_dropped\": {}, \"followers_rejoined\": {}, \"late_answers\": {}, "
+        "\"barrier_wait_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"leader_present\": {}, \"leader_lost\": {}, "
+        "\"frames_drawn\": {}, \"last_frame\": {}, \"skipped\": {}, \"presents_missed\": {}, \"skew_frames_max\": {}, "
+        "\"clock_offset_us\": {}, \"delay_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"malformed\": {}}},\n",
+        jsonString(l->leader ? "leader" : "follower"), jsonString(l->node), l->followers, l->followersKnown,
+        l->barrierTimeouts, l->followersDropped, l->followersRejoined, l->lateAnswers, l->barrierWaitP50Ms,
+        l->barrierWaitMaxMs, l->leaderPresent ? "true" : "false", l->leaderLost, l->framesDrawn, l->lastFrame,
+        l->skipped, l->presentsMissed, l->maxSkewFrames, l->leader ? l->maxClockOffsetUs : l->clockOffsetUs,
+        l->delayP50Ms, l->delayMaxMs, l->malformed);
+  }
   out += "  \"devices\": [";
   for (std::size_t i = 0; i < s.devices.size(); ++i) {
     const DeviceStatus& d = s.devices[i];
@@ -241,6 +258,35 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
   for (const StreamStatus& st : s.streams) {
     out += fmt::format("basalt_stream_up{{stream=\"{}\",kind=\"{}\",state=\"{}\"}} {}\n", promLabel(st.name), st.kind,
                        st.state, st.state == "playing" ? 1 : 0);
+  }
+  if (const std::optional<FrameLockFigures>& l = s.lock) {
+    const auto lockMetric = [&](std::string_view name, std::string_view type, std::string_view help, auto value) {
+      metric(name, type, help);
+      out += fmt::format("{}{{node=\"{}\",role=\"{}\"}} {}\n", name, promLabel(l->node),
+                         l->leader ? "leader" : "follower", value);
+    };
+    if (l->leader) {
+      lockMetric("basalt_lock_followers", "gauge", "Followers in the frame barrier now.", l->followers);
+      lockMetric("basalt_lock_barrier_timeouts_total", "counter",
+                 "Frames the leader presented without every follower's answer.", l->barrierTimeouts);
+      lockMetric("basalt_lock_followers_dropped_total", "counter", "Times a follower left the barrier.",
+                 l->followersDropped);
+      lockMetric("basalt_lock_late_answers_total", "counter", "Followers' answers for frames already presented.",
+                 l->lateAnswers);
+      lockMetric("basalt_lock_barrier_wait_ms", "gauge", "The leader's median wait for the answers (ms).",
+                 fmt::format("{:.3f}", l->barrierWaitP50Ms));
+    } else {
+      lockMetric("basalt_lock_leader_present", "gauge", "1 while the leader is heard.", l->leaderPresent ? 1 : 0);
+      lockMetric("basalt_lock_leader_lost_total", "counter", "Times the leader went quiet.", l->leaderLost);
+      lockMetric("basalt_lock_frames_skipped_total", "counter", "Leader frames this follower passed over.", l->skipped);
+      lockMetric("basalt_lock_presents_missed_total", "counter", "Frames presented without the leader's word.",
+                 l->presentsMissed);
+      lockMetric("basalt_lock_skew_frames_max", "gauge", "Largest lead of the leader's presented frame over ours.",
+                 l->maxSkewFrames);
+      lockMetric("basalt_lock_clock_offset_us", "gauge", "The shared clock minus this node's clock (us).",
+                 l->clockOffsetUs);
+    }
+    lockMetric("basalt_lock_malformed_total", "counter", "Frame-lock messages rejected.", l->malformed);
   }
   metric("basalt_reloads_total", "counter", "Reloads asked for (SIGHUP or the control server).");
   out += fmt::format("basalt_reloads_total {}\n", s.reloads);

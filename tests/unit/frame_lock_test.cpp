@@ -14,6 +14,8 @@
 #include "kiosk/frame_lock.h"
 #include "kiosk/lock_protocol.h"
 #include "kiosk/manifest.h"
+#include "kiosk/status_board.h"
+#include "kiosk/status_report.h"
 #include "render/output.h"
 #include "runtime/event_loop.h"
 #include "runtime/show/show.h"
@@ -420,6 +422,47 @@ TEST(FrameLock, ALostLeaderIsReportedAndItsReturnNoticed) {
   }
   ASSERT_EQ(drawn.size(), 10U);
   EXPECT_EQ(drawn[5], 100);
+}
+
+}  // namespace
+}  // namespace basalt::kiosk
+
+namespace basalt::kiosk {
+namespace {
+
+// Makes sure a frame-locked node's figures reach /health and /metrics, and that a follower
+// without its leader reads as degraded. Example failure: a lost leader the status page calls ok.
+TEST(FrameLockStatus, FiguresReachHealthAndMetrics) {
+  StatusSnapshot s;
+  FrameLockFigures follower;
+  follower.node = "north";
+  follower.leaderPresent = true;
+  follower.skipped = 4;
+  follower.clockOffsetUs = -35;
+  s.lock = follower;
+  EXPECT_EQ(overallState(s), "ok");
+  const std::string health = healthJson(s);
+  EXPECT_NE(health.find("\"lock\": {\"role\": \"follower\", \"node\": \"north\""), std::string::npos) << health;
+  EXPECT_NE(health.find("\"skipped\": 4"), std::string::npos);
+  const std::string metrics = metricsText(s, ServerCounters{});
+  EXPECT_NE(metrics.find("basalt_lock_frames_skipped_total{node=\"north\",role=\"follower\"} 4"), std::string::npos)
+      << metrics;
+  EXPECT_NE(metrics.find("basalt_lock_clock_offset_us{node=\"north\",role=\"follower\"} -35"), std::string::npos);
+
+  s.lock->leaderPresent = false;
+  EXPECT_EQ(overallState(s), "degraded");
+
+  FrameLockFigures leader;
+  leader.leader = true;
+  leader.node = "hub";
+  leader.followers = 1;
+  leader.followersKnown = 2;
+  s.lock = leader;
+  EXPECT_EQ(overallState(s), "degraded");  // a follower it knew is out of the barrier
+  EXPECT_NE(metricsText(s, ServerCounters{}).find("basalt_lock_followers{node=\"hub\",role=\"leader\"} 1"),
+            std::string::npos);
+  s.lock.reset();
+  EXPECT_EQ(healthJson(s).find("\"lock\""), std::string::npos);
 }
 
 }  // namespace
