@@ -469,7 +469,7 @@ void V4l2Camera::stopStreaming(bool waitForShow) {
   req.memory = V4L2_MEMORY_MMAP;
   if (xioctl(fd_.get(), VIDIOC_REQBUFS, &req) != 0) {
     // The driver keeps the buffers, and refuses a new format or new timings while it does.
-    log::debug(kLogV4l2, "{}: cannot free the capture buffers: {}", path_, std::strerror(errno));
+    log::warn(kLogV4l2, "{}: cannot free the capture buffers: {}", path_, std::strerror(errno));
   }
 }
 
@@ -569,7 +569,11 @@ void V4l2Camera::handleEvents() {
 
 void V4l2Camera::captureLoop() {
   for (;;) {
-    pollfd fds[2] = {{fd_.get(), POLLIN | POLLPRI, 0}, {stopFd_.get(), POLLIN, 0}};
+    // POLLIN only while streaming: polling a capture queue that has no buffers for input makes
+    // videobuf2 start its read() emulation, which allocates buffers behind Basalt's back, and a
+    // queue with buffers refuses new DV timings and formats (EBUSY) for good.
+    const short input = buffers_ ? POLLIN : 0;
+    pollfd fds[2] = {{fd_.get(), static_cast<short>(input | POLLPRI), 0}, {stopFd_.get(), POLLIN, 0}};
     if (::poll(fds, 2, 1000) < 0) {
       if (errno == EINTR) continue;
       reportLost(sysError(path_, "poll", errno));
