@@ -103,6 +103,17 @@ std::function<bool(bool)> gadget(const std::string& name) {
   return [name](bool plug) { return gadgetCtl(plug ? "plug" : "unplug", name); };
 }
 
+/// The number of file descriptors this process has open.
+std::size_t openFds() {
+  std::size_t n = 0;
+  std::error_code ec;
+  for (auto it = std::filesystem::directory_iterator("/proc/self/fd", ec);
+       !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
+    ++n;
+  }
+  return n;
+}
+
 /// Unbinds or binds (plug) a platform device from its driver through sysfs, as a driver reload
 /// or a capture card's firmware reset does.
 bool platformBind(const std::string& driver, const std::string& device, bool plug) {
@@ -129,12 +140,17 @@ void hotplugRoundTrip(DeviceKind kind, const std::function<bool(bool plug)>& cab
   auto state = [&] { return manager.status()[0].state; };
   auto idle = [] {};
   ASSERT_TRUE(waitFor(idle, [&] { return state() == DeviceState::kLive; }, 10s)) << manager.status()[0].lastError;
+  const std::size_t fdsLive = openFds();
   ASSERT_TRUE(cable(false));
   EXPECT_TRUE(waitFor(idle, [&] { return state() == DeviceState::kLost || state() == DeviceState::kReopening; }, 10s));
   ASSERT_TRUE(cable(true));
   EXPECT_TRUE(waitFor(
       idle, [&] { return state() == DeviceState::kLive; }, 20s))
       << "not live again after the replug: " << manager.status()[0].lastError;
+  // Live again with what it held before: the lost device's descriptors were all closed.
+  EXPECT_TRUE(waitFor(
+      idle, [&] { return openFds() <= fdsLive; }, 5s))
+      << openFds() << " descriptors open, " << fdsLive << " before the unplug";
   manager.stop();
   if (monitor) (*monitor)->stop();
 }
