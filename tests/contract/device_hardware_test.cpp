@@ -9,7 +9,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -88,6 +90,73 @@ TEST(V4l2Hardware, EnumerationDescribesTheWebcam) {
   bool listed = false;
   for (const auto& c : provider.enumerate()) listed = listed || c.info.path == *node;
   EXPECT_TRUE(listed);
+}
+
+// Every format vivid's webcam offers that Basalt handles, each streamed with plain mmap buffers
+// and with buffers exported as dmabufs: the frames come in that format and size, with its planes,
+// in order, their driver timestamps rising at about the frame interval and close to now on the
+// show's clock. Example failures: a format whose planes are laid out wrongly; dmabuf export that
+// silently falls back to mmap; timestamps from another clock.
+TEST(V4l2Hardware, WebcamStreamsEachFormatWithMmapAndDmabuf) {
+  const auto node = test::vlabEnv("BASALT_VLAB_V4L2_WEBCAM");
+  if (!node) GTEST_SKIP() << test::needsVlab("BASALT_VLAB_V4L2_WEBCAM (vivid webcam input)");
+  auto d = describeV4l2Device(*node);
+  ASSERT_TRUE(d) << d.error().describe();
+  std::vector<PixelFormat> formats;
+  for (const VideoMode& m : d->modes) {
+    if (std::find(formats.begin(), formats.end(), m.format) == formats.end()) formats.push_back(m.format);
+  }
+  ASSERT_GE(formats.size(), 3u) << "vivid offers YUYV, NV12 and more";
+  SystemClock clock;
+  for (const PixelFormat format : formats) {
+    for (const bool dmabuf : {false, true}) {
+      SCOPED_TRACE(std::string(pixelFormatName(format)) + (dmabuf ? " with dmabuf export" : " with mmap"));
+      V4l2Options options;
+      options.format = format;
+      options.width = 640;
+      options.height = 360;
+      options.exportDmabuf = dmabuf;
+      auto source = makeV4l2Camera(*node, options, clock);
+      auto opened = source->open(1);
+      ASSERT_TRUE(opened) << opened.error().describe();
+      EXPECT_EQ(source->mode().format, format);
+      std::vector<FrameRef> frames;
+      const auto start = std::chrono::steady_clock::now();
+      while (frames.size() < 4 && std::chrono::steady_clock::now() - start < 10s) {
+        source->service(clock.now());
+        if (FrameRef f = source->frameAt(clock.now())) frames.push_back(std::move(f));
+        std::this_thread::sleep_for(5ms);
+      }
+      ASSERT_GE(frames.size(), 4u) << "frames in 10 s";
+      const VideoMode mode = source->mode();
+      const Nanos interval = mode.fps > 0 ? Nanos{static_cast<std::int64_t>(1e9 / mode.fps)} : Nanos{0};
+      for (std::size_t i = 0; i < frames.size(); ++i) {
+        const Frame& f = *frames[i];
+        EXPECT_EQ(f.format, format);
+        EXPECT_EQ(f.width, mode.width);
+        EXPECT_EQ(f.height, mode.height);
+        EXPECT_GE(f.planeCount, 1);
+        for (int p = 0; p < f.planeCount; ++p) {
+          const Plane& plane = f.planes[static_cast<std::size_t>(p)];
+          EXPECT_NE(plane.data, nullptr) << "plane " << p;
+          EXPECT_EQ(plane.dmabufFd >= 0, dmabuf) << "plane " << p;
+        }
+        // Driver timestamps (CLOCK_MONOTONIC) on the show's clock: in the last few seconds.
+        EXPECT_LE(f.captureTime, clock.now());
+        EXPECT_GT(f.captureTime, clock.now() - 15s);
+        if (i == 0) continue;
+        const Nanos step = f.captureTime - frames[i - 1]->captureTime;
+        EXPECT_GT(step, Nanos{0}) << "timestamps rise";
+        if (interval.count() > 0) {
+          // Frames the test missed (it polls every 5 ms under emulation) make whole intervals.
+          const double intervals = static_cast<double>(step.count()) / static_cast<double>(interval.count());
+          EXPECT_NEAR(intervals, std::round(intervals), 0.35) << "step " << step.count() << " ns";
+        }
+      }
+      frames.clear();
+      source->close();
+    }
+  }
 }
 
 /// Unplugs and replugs a gadget with the lab's control program.
