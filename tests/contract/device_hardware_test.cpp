@@ -9,7 +9,10 @@
 
 #include <gtest/gtest.h>
 
+#include <poll.h>
+
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -22,6 +25,8 @@
 #include "devices/hid/hid_backend.h"
 #include "devices/udev/udev_monitor.h"
 #include "devices/v4l2/v4l2_camera.h"
+#include "sim/vlab/uvc/usb_powermate.h"
+#include "sim/vlab/uvc/usbip.h"
 #include "vlab.h"
 
 namespace basalt::devices {
@@ -279,6 +284,112 @@ TEST(HotplugHardware, VividUnboundAndBoundAgain) {
       std::make_unique<V4l2Provider>());
   EXPECT_TRUE(waitFor([] {}, [&] { return std::filesystem::exists(*node); }, 10s))
       << *node << " did not come back (later cases use it)";
+}
+
+// A PowerMate emulated in user space and plugged into the guest's vhci_hcd (the HID core leaves
+// it alone, as it does the real knob): Basalt's libusb backend sets its LED's brightness and pulse
+// through the vendor request, which the knob records, and its turns and presses arrive as dial
+// and button events. Example failures: a wrong request type or setting number (the knob would
+// stall it or record nothing); a rotation byte read unsigned (a turn back goes forward).
+TEST(PowerMateHardware, LightAndKnobOfAnEmulatedPowerMate) {
+  const auto vhci = test::vlabEnv("BASALT_VLAB_VHCI");
+  if (!vhci) GTEST_SKIP() << test::needsVlab("BASALT_VLAB_VHCI (the USB/IP virtual host controller)");
+  SystemClock clock;
+  HidProvider provider;
+  auto powerMates = [&] {
+    std::vector<std::string> paths;
+    for (const DeviceCandidate& c : provider.enumerate()) {
+      if (c.info.vendor == 0x077d && c.info.product == 0x0410 && c.info.path.starts_with("usb:")) {
+        paths.push_back(c.info.path);
+      }
+    }
+    return paths;
+  };
+  const std::vector<std::string> before = powerMates();  // the lab's gadget knob, if any
+
+  sim::vlab::UsbPowerMate knob;
+  auto attached = sim::vlab::VhciAttachment::attach(knob, clock, *vhci);
+  ASSERT_TRUE(attached) << attached.error().describe();
+  std::atomic<bool> stop{false};
+  std::thread server([&] {
+    auto& link = attached->link();
+    while (!stop.load()) {
+      pollfd p{link.fd(), POLLIN, 0};
+      (void)::poll(&p, 1, 5);
+      if ((p.revents & (POLLIN | POLLHUP | POLLERR)) != 0 && !link.onReadable()) break;
+      if (!link.serviceTransfers()) break;
+    }
+  });
+  struct Join {
+    std::atomic<bool>& stop;
+    std::thread& thread;
+    ~Join() {
+      stop = true;
+      thread.join();
+    }
+  } join{stop, server};
+
+  std::string path;
+  ASSERT_TRUE(waitFor([] {},
+                      [&] {
+                        for (const std::string& p : powerMates()) {
+                          if (std::find(before.begin(), before.end(), p) == before.end()) path = p;
+                        }
+                        return !path.empty();
+                      },
+                      15s))
+      << "the emulated PowerMate did not enumerate";
+  auto box = openPowerMate(path, clock);
+  ASSERT_TRUE(box) << box.error().describe();
+  BoundedQueue<Event> events(256);
+  auto opened = (*box)->open(7, events);
+  ASSERT_TRUE(opened) << opened.error().describe();
+
+  ASSERT_TRUE((*box)->setLight(0, 0.5, false));
+  EXPECT_EQ(knob.led().brightness, 128);
+  EXPECT_EQ(knob.led().pulse, 0);
+  ASSERT_TRUE((*box)->setLight(0, 1.0, true));
+  EXPECT_EQ(knob.led().brightness, 255);
+  EXPECT_EQ(knob.led().pulse, 1);
+  EXPECT_FALSE((*box)->setLight(1, 1.0, false)) << "the PowerMate has one light";
+
+  std::vector<Event> got;
+  auto collect = [&](std::size_t n) {
+    return waitFor(
+        [&] {
+          (*box)->service(clock.now());
+          Event e;
+          while (events.pop(e)) got.push_back(e);
+        },
+        [&] { return got.size() >= n; }, 5s);
+  };
+  knob.pushReport(0, 3);
+  ASSERT_TRUE(collect(1)) << "a turn forward";
+  EXPECT_EQ(got[0].kind, EventKind::kDialDelta);
+  EXPECT_EQ(got[0].device, 7u);
+  EXPECT_GT(got[0].value, 0.0);
+  knob.pushReport(0, -2);
+  ASSERT_TRUE(collect(2)) << "a turn back";
+  EXPECT_EQ(got[1].kind, EventKind::kDialDelta);
+  EXPECT_LT(got[1].value, 0.0);
+  EXPECT_NEAR(got[1].value, -got[0].value * 2.0 / 3.0, 1e-9);
+  knob.pushReport(1, 0);
+  knob.pushReport(0, 0);
+  ASSERT_TRUE(collect(4)) << "a press and a release";
+  EXPECT_EQ(got[2].kind, EventKind::kButton);
+  EXPECT_EQ(got[2].value, 1.0);
+  EXPECT_EQ(got[3].kind, EventKind::kButton);
+  EXPECT_EQ(got[3].value, 0.0);
+  (*box)->close();
+  // Unplugged: gone from the bus before the next case looks for a PowerMate.
+  attached->detach();
+  EXPECT_TRUE(waitFor([] {},
+                      [&] {
+                        const auto now = powerMates();
+                        return std::find(now.begin(), now.end(), path) == now.end();
+                      },
+                      10s))
+      << path << " is still listed after the unplug";
 }
 
 TEST(UdevHotplug, MonitorStartsOrSaysWhy) {
