@@ -12,8 +12,9 @@ node's summary line ("frame lock: ...") to check that all of them drew the same 
                                             frame, the restarted one draws a contiguous tail to
                                             the last frame, the leader reports the drop and rejoin
   frame_lock_netns_test.py BASALT netem     the same with 5 % loss and 20 ms delay on both links
-                                            (tc netem): the followers draw every frame; skew and
-                                            clock offset are printed
+                                            (tc netem): the followers draw at least 80 % of the
+                                            frames, to the last, skipping the rest (counted),
+                                            with a bounded skew; skew and clock offset printed
 
 Exits 77 (ctest: skipped) with the reason when not root, without `ip netns` or veth, or (netem)
 without the sch_netem qdisc. Example failure caught: a follower that draws its own frame count
@@ -152,7 +153,7 @@ def follower_lock(name, net):
     return f'role = "follower"\nnode = "{name}"\nleader = "10.77.{net}.1"\nport = {PORT}\nleader_timeout_ms = 3000\n'
 
 
-def run_steady(basalt, work, frames, timeout_ms, label):
+def run_steady(basalt, work, frames, timeout_ms, label, strict=True):
     lshow = write_show(os.path.join(work, "leader"), leader_lock(timeout_ms))
     ashow = write_show(os.path.join(work, "a"), follower_lock("a", 1))
     bshow = write_show(os.path.join(work, "b"), follower_lock("b", 2))
@@ -173,9 +174,19 @@ def run_steady(basalt, work, frames, timeout_ms, label):
         line, _ = summary(log)
         f = follower_figures(line)
         print(f"[{label}] {name}: {line}")
-        assert f["drawn"] == frames and f["first"] == 0 and f["last"] == frames - 1, f
-        assert f["checksum"] == want, f"{name} drew other frame numbers than 0..{frames - 1}"
-        assert f["skipped"] == 0, f
+        assert f["first"] == 0 and f["last"] == frames - 1 and f["lost"] == 0, f
+        if strict:
+            assert f["drawn"] == frames, f
+            assert f["checksum"] == want, f"{name} drew other frame numbers than 0..{frames - 1}"
+            assert f["skipped"] == 0, f
+        else:
+            # Degraded, not broken: a lost packet is a TCP retransmission (200 ms and more), so a
+            # follower sometimes answers late, the leader presents without it and the follower
+            # skips to the newest frame; each is counted. It still draws nearly every frame, to
+            # the last, and is never more than a few frames behind the leader.
+            assert f["drawn"] + f["skipped"] == frames, f
+            assert f["drawn"] >= frames * 0.8, f
+            assert f["skew"] <= 30, f
         worst_skew = max(worst_skew, f["skew"])
         worst_offset = max(worst_offset, f["maxoffset"])
     print(f"[{label}] {frames} frames in {elapsed:.1f} s; skew at most {worst_skew} frames; "
@@ -228,7 +239,8 @@ def main():
         elif mode == "netem":
             add_netem()
             # A frame's answer takes two 20 ms hops: the barrier waits long enough for them.
-            run_steady(basalt, work, 1000, 250, "netem")
+            lf = run_steady(basalt, work, 1000, 250, "netem", strict=False)
+            assert lf["inbarrier"] == 2, lf
         else:
             print(f"unknown mode {mode}")
             return 2
