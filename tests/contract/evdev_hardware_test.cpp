@@ -92,7 +92,9 @@ TEST(EvdevHardware, UinputKeyboardAndMouseReachTheShowAndTheKeyboardReplugs) {
     }
   }
   // The lab's dial box (hid-generic gives it relative X and Y axes and BTN_0..7) is left alone.
-  if (test::vlabEnv("BASALT_VLAB_HID_DIAL")) EXPECT_TRUE(sawDialBox) << "the dial box's input node was not seen";
+  if (test::vlabEnv("BASALT_VLAB_HID_DIAL")) {
+    EXPECT_TRUE(sawDialBox) << "the dial box's input node was not seen";
+  }
 
   ASSERT_TRUE(keyboard->emit(EV_KEY, KEY_LEFT, 1));
   ASSERT_TRUE(keyboard->sync());
