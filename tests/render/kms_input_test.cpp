@@ -68,6 +68,11 @@ token_file = "token"
   auto show = test::RunningShow::start(
       {(dir / "show.toml").string(), "--no-resume", "--output-dir", (dir / "out").string()}, {}, why);
   ASSERT_TRUE(show) << why;
+  // A key pressed before the reader opened the keyboard never reaches it (evdev delivers to the
+  // open handles only): wait for the reader, then for the first frame on the display.
+  ASSERT_TRUE(show->process().waitForOutput("reading keyboard 'Basalt Lab Kiosk Keyboard'", std::chrono::seconds(60)))
+      << show->process().outputSoFar();
+  ASSERT_TRUE(show->process().waitForOutput("first frame", std::chrono::seconds(60))) << show->process().outputSoFar();
   // The thesis' Xskew small step up is Shift and ':' (the ';' key); Shift and 'S' turn the side.
   ASSERT_TRUE(keyboard->key(KEY_LEFTSHIFT, 1));
   ASSERT_TRUE(keyboard->key(KEY_SEMICOLON, 1));
@@ -77,11 +82,15 @@ token_file = "token"
   ASSERT_TRUE(keyboard->key(KEY_LEFTSHIFT, 0));
   const std::string bearer = "Bearer " + token;
   std::string settings;
+  int status = 0;
   for (int attempt = 0; attempt < 100; ++attempt) {
-    settings = show->post("/control/calibrate", "", bearer).body;
+    const auto answer = show->post("/control/calibrate", "", bearer);
+    status = answer.status;
+    settings = answer.body;
     if (settings.find("side[1]") != std::string::npos) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
+  EXPECT_EQ(status, 200) << settings;
   EXPECT_NE(settings.find("Xskew[0.5]"), std::string::npos) << settings << "\n" << show->process().outputSoFar();
   EXPECT_NE(settings.find("side[1]"), std::string::npos) << settings;
   EXPECT_NE(show->process().outputSoFar().find("reading keyboard 'Basalt Lab Kiosk Keyboard'"), std::string::npos)

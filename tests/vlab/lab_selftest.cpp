@@ -164,6 +164,7 @@ TEST(LabEnvironment, EveryContractVariableIsSetAndWellFormed) {
   EXPECT_EQ(env("BASALT_VLAB_UDEV"), "1") << fixtureLine("udev");
   EXPECT_TRUE(fs::is_directory(env("BASALT_VLAB_VHCI"))) << fixtureLine("vhci");
   EXPECT_FALSE(env("BASALT_VLAB_UVC_CONTROL").empty()) << fixtureLine("uvc");
+  EXPECT_EQ(env("BASALT_VLAB_LOOPBACK"), "1") << fixtureLine("loopback");
 }
 
 // Makes sure vivid's webcam input is a webcam and streams frames through mmap. Example failure:

@@ -89,6 +89,14 @@ video_node_of_driver() { # the capture /dev/videoN bound to driver $1 (index 0 o
   return 1
 }
 
+# ---- loopback: the shows' status servers listen on 127.0.0.1 -------------------------------
+if ip link set lo up 2>/dev/null || ifconfig lo 127.0.0.1 up 2>/dev/null; then
+  setenv BASALT_VLAB_LOOPBACK 1
+  fixture_ok loopback "lo is up (127.0.0.1)"
+else
+  fixture_fail loopback "cannot bring lo up: the status-server cases cannot connect"
+fi
+
 # ---- V4L2: vivid, instance 0 a webcam, instance 1 an HDMI input ----------------------------
 # node_types 0x1: a video capture node only; input_types: 2 bits per input, 00 webcam, 11 HDMI.
 if load vivid n_devs=2 node_types=0x1,0x1 num_inputs=1,1 input_types=0x0,0x3; then
