@@ -48,12 +48,14 @@ def main():
         check("a crash inside the lab exits 128+SIGSEGV", status == 139, out)
         check("a crash inside the lab is named a crash", "crashed inside the lab (SIGSEGV)" in out, out)
         check("the crashing program's own output is shown", "before the crash" in out, out)
+        check("the console tail is shown for a crash", "console tail:" in out, out)
 
         # A program that runs past its limit inside the lab: killed, said so.
         status, out, _ = vlab("run", "--results", os.path.join(tmp, "hang"), "--timeout", "3", "--",
                               "/bin/sleep", "600")
         check("a program past its limit is stopped (status 124)", status == 124, out)
         check("a program past its limit is said to have timed out", "timed out inside the lab" in out, out)
+        check("the console tail is shown for a time-out", "console tail:" in out, out)
 
         # A lab that cannot boot in time: stopped, reported with the console tail.
         status, out, took = vlab("run", "--results", os.path.join(tmp, "boot"), "--boot-timeout", "1", "--",
