@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include "devices/hid/dial_decoder.h"
@@ -256,6 +257,243 @@ TEST(DialProfiles, AbsoluteWrappingAxisGivesDeltas) {
   auto events = decodeAll(*d, b);
   ASSERT_EQ(events.size(), 1u);
   EXPECT_DOUBLE_EQ(events[0].value, 10.0 / 256);
+}
+
+// A 6-axis puck laid out like 3Dconnexion's SpaceNavigator: translations X/Y/Z in report 1,
+// rotations Rx/Ry/Rz in report 2 (16-bit relative, -350..350, a length unit that is no
+// rotation), two buttons in report 3. The application usage is a parameter: the SpaceMouse
+// declares Multi-axis Controller, the puck pattern of the Surface Dial System Multi-Axis Controller.
+std::vector<std::uint8_t> sixAxisPuckDescriptor(std::uint8_t application) {
+  std::vector<std::uint8_t> desc = {
+      0x05, 0x01,        // Usage Page (Generic Desktop)
+      0x09, 0x08,        // Usage (Multi-axis Controller; replaced by `application`)
+      0xa1, 0x01,        // Collection (Application)
+      0xa1, 0x00,        //   Collection (Physical)
+      0x85, 0x01,        //     Report ID (1)
+      0x16, 0xa2, 0xfe,  //     Logical Minimum (-350)
+      0x26, 0x5e, 0x01,  //     Logical Maximum (350)
+      0x36, 0x88, 0xfa,  //     Physical Minimum (-1400)
+      0x46, 0x78, 0x05,  //     Physical Maximum (1400)
+      0x55, 0x0c,        //     Unit Exponent (-4)
+      0x65, 0x11,        //     Unit (SI Linear: cm)
+      0x09, 0x30,        //     Usage (X)
+      0x09, 0x31,        //     Usage (Y)
+      0x09, 0x32,        //     Usage (Z)
+      0x75, 0x10,        //     Report Size (16)
+      0x95, 0x03,        //     Report Count (3)
+      0x81, 0x06,        //     Input (Data, Variable, Relative)
+      0xc0,              //   End Collection
+      0xa1, 0x00,        //   Collection (Physical)
+      0x85, 0x02,        //     Report ID (2)
+      0x09, 0x33,        //     Usage (Rx)
+      0x09, 0x34,        //     Usage (Ry)
+      0x09, 0x35,        //     Usage (Rz)
+      0x75, 0x10,        //     Report Size (16)
+      0x95, 0x03,        //     Report Count (3)
+      0x81, 0x06,        //     Input (Data, Variable, Relative)
+      0xc0,              //   End Collection
+      0xa1, 0x02,        //   Collection (Logical)
+      0x85, 0x03,        //     Report ID (3)
+      0x05, 0x09,        //     Usage Page (Button)
+      0x19, 0x01,        //     Usage Minimum (1)
+      0x29, 0x02,        //     Usage Maximum (2)
+      0x15, 0x00,        //     Logical Minimum (0)
+      0x25, 0x01,        //     Logical Maximum (1)
+      0x35, 0x00,        //     Physical Minimum (0)
+      0x45, 0x01,        //     Physical Maximum (1)
+      0x75, 0x01,        //     Report Size (1)
+      0x95, 0x02,        //     Report Count (2)
+      0x81, 0x02,        //     Input (Data, Variable, Absolute)
+      0x95, 0x0e,        //     Report Count (14)
+      0x81, 0x03,        //     Input (Constant): padding
+      0xc0,              //   End Collection
+      0xc0,              // End Collection
+  };
+  desc[3] = application;
+  return desc;
+}
+
+// Makes sure a SpaceMouse-like puck gives six relative dials, rotations before translations
+// (dials 0-2 rotate in LAVA's table), each read from its own report id, and its two buttons.
+// Example failures: the rotations of report 2 read from report 1's bytes; the cm unit taken for
+// a rotation unit (a wrong scale); a negative 16-bit value read as 65 000 counts.
+TEST(DialProfiles, SixAxisPuckMapsRotationsThenTranslations) {
+  for (const std::uint8_t application : {std::uint8_t{0x08}, std::uint8_t{0x0e}}) {
+    SCOPED_TRACE(application == 0x08 ? "Multi-axis Controller" : "System Multi-Axis Controller");
+    auto d = DialDecoder::create(0x046d, 0xc626, sixAxisPuckDescriptor(application), "puck");
+    ASSERT_TRUE(d) << d.error().describe();
+    EXPECT_EQ(d->profile(), DialProfile::kGenericHid);
+    ASSERT_EQ(d->dialCount(), 6);
+    EXPECT_EQ(d->buttonCount(), 2);
+    const std::uint32_t order[] = {hid::usages::kRx, hid::usages::kRy, hid::usages::kRz,
+                                   hid::usages::kX,  hid::usages::kY,  hid::usages::kZ};
+    for (std::size_t i = 0; i < 6; ++i) {
+      EXPECT_EQ(d->channels()[i].usage, order[i]) << "dial " << i;
+      EXPECT_EQ(d->channels()[i].kind, EventKind::kDialDelta) << "dial " << i;
+      EXPECT_DOUBLE_EQ(d->channels()[i].countsPerTurn, kAxisCountsPerTurn) << "dial " << i;
+    }
+    // Report 1: X +10, Y -5, Z 0 (no event for an axis at rest).
+    const std::uint8_t push[] = {0x01, 0x0a, 0x00, 0xfb, 0xff, 0x00, 0x00};
+    auto events = decodeAll(*d, push);
+    ASSERT_EQ(events.size(), 2u);
+    EXPECT_EQ(events[0].index, 3);
+    EXPECT_DOUBLE_EQ(events[0].value, 10 / kAxisCountsPerTurn);
+    EXPECT_EQ(events[1].index, 4);
+    EXPECT_DOUBLE_EQ(events[1].value, -5 / kAxisCountsPerTurn);
+    // Report 2: Rx 0, Ry -350 (its minimum), Rz +350 (its maximum).
+    const std::uint8_t twist[] = {0x02, 0x00, 0x00, 0xa2, 0xfe, 0x5e, 0x01};
+    events = decodeAll(*d, twist);
+    ASSERT_EQ(events.size(), 2u);
+    EXPECT_EQ(events[0].index, 1);
+    EXPECT_DOUBLE_EQ(events[0].value, -350 / kAxisCountsPerTurn);
+    EXPECT_EQ(events[1].index, 2);
+    EXPECT_DOUBLE_EQ(events[1].value, 350 / kAxisCountsPerTurn);
+    // The same report again turns again: relative axes have no memory.
+    EXPECT_EQ(decodeAll(*d, twist).size(), 2u);
+    // Report 3: the right button (bit 1) down, then both up.
+    const std::uint8_t right[] = {0x03, 0x02, 0x00};
+    events = decodeAll(*d, right);
+    ASSERT_EQ(events.size(), 1u);
+    EXPECT_EQ(events[0].kind, EventKind::kButton);
+    EXPECT_EQ(events[0].index, 1);
+    EXPECT_EQ(events[0].value, 1);
+    const std::uint8_t none[] = {0x03, 0x00, 0x00};
+    events = decodeAll(*d, none);
+    ASSERT_EQ(events.size(), 1u);
+    EXPECT_EQ(events[0].value, 0);
+    // A short report 1 (one axis cut off) gives what it holds and nothing past its end.
+    const std::uint8_t cut[] = {0x01, 0x01, 0x00, 0x02};
+    events = decodeAll(*d, cut);
+    ASSERT_EQ(events.size(), 1u);
+    EXPECT_EQ(events[0].index, 3);
+    expectPrefixesSafe(sixAxisPuckDescriptor(application));
+  }
+}
+
+// Makes sure a mouse-like X/Y relative pair maps to two dials after its wheel, signed 8-bit,
+// with the buttons before them in the report. Example failure: X read from the button byte.
+TEST(DialProfiles, RelativeXYPairMapsToDialsAfterTheWheel) {
+  const std::vector<std::uint8_t> desc = {
+      0x05, 0x01,              // Usage Page (Generic Desktop)
+      0x09, 0x02,              // Usage (Mouse)
+      0xa1, 0x01,              // Collection (Application)
+      0x09, 0x01,              //   Usage (Pointer)
+      0xa1, 0x00,              //   Collection (Physical)
+      0x05, 0x09,              //     Usage Page (Button)
+      0x19, 0x01,              //     Usage Minimum (1)
+      0x29, 0x03,              //     Usage Maximum (3)
+      0x15, 0x00,              //     Logical Minimum (0)
+      0x25, 0x01,              //     Logical Maximum (1)
+      0x75, 0x01, 0x95, 0x03,  //     Report Size (1), Report Count (3)
+      0x81, 0x02,              //     Input (Data, Variable, Absolute)
+      0x75, 0x05, 0x95, 0x01,  //     Report Size (5), Report Count (1)
+      0x81, 0x03,              //     Input (Constant): padding
+      0x05, 0x01,              //     Usage Page (Generic Desktop)
+      0x09, 0x30,              //     Usage (X)
+      0x09, 0x31,              //     Usage (Y)
+      0x09, 0x38,              //     Usage (Wheel)
+      0x15, 0x81,              //     Logical Minimum (-127)
+      0x25, 0x7f,              //     Logical Maximum (127)
+      0x75, 0x08, 0x95, 0x03,  //     Report Size (8), Report Count (3)
+      0x81, 0x06,              //     Input (Data, Variable, Relative)
+      0xc0,                    //   End Collection
+      0xc0,                    // End Collection
+  };
+  auto d = DialDecoder::create(0x1234, 0x0001, desc, "mouse");
+  ASSERT_TRUE(d) << d.error().describe();
+  ASSERT_EQ(d->dialCount(), 3);
+  EXPECT_EQ(d->buttonCount(), 3);
+  EXPECT_EQ(d->channels()[0].usage, hid::usages::kWheel);
+  EXPECT_DOUBLE_EQ(d->channels()[0].countsPerTurn, kWheelCountsPerTurn);
+  EXPECT_EQ(d->channels()[1].usage, hid::usages::kX);
+  EXPECT_EQ(d->channels()[2].usage, hid::usages::kY);
+  for (int i = 1; i < 3; ++i) {
+    EXPECT_EQ(d->channels()[static_cast<std::size_t>(i)].kind, EventKind::kDialDelta);
+    EXPECT_DOUBLE_EQ(d->channels()[static_cast<std::size_t>(i)].countsPerTurn, kAxisCountsPerTurn);
+  }
+  // Left button, X +3, Y -128 is outside -127..127 (no reading), wheel 0.
+  const std::uint8_t moved[] = {0x01, 0x03, 0x80, 0x00};
+  auto events = decodeAll(*d, moved);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].kind, EventKind::kDialDelta);
+  EXPECT_EQ(events[0].index, 1);
+  EXPECT_DOUBLE_EQ(events[0].value, 3 / kAxisCountsPerTurn);
+  EXPECT_EQ(events[1].kind, EventKind::kButton);
+  EXPECT_EQ(events[1].index, 0);
+  // X -2, Y +7, wheel -1, left still down.
+  const std::uint8_t again[] = {0x01, 0xfe, 0x07, 0xff};
+  events = decodeAll(*d, again);
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[0].index, 0);
+  EXPECT_DOUBLE_EQ(events[0].value, -1 / kWheelCountsPerTurn);
+  EXPECT_EQ(events[1].index, 1);
+  EXPECT_DOUBLE_EQ(events[1].value, -2 / kAxisCountsPerTurn);
+  EXPECT_EQ(events[2].index, 2);
+  EXPECT_DOUBLE_EQ(events[2].value, 7 / kAxisCountsPerTurn);
+}
+
+// Makes sure an absolute Rz with the Wrap flag, 10 bits packed after 6 button bits, gives
+// deltas across the wrap both ways, and that an absolute Z without Wrap stays an absolute dial.
+// Example failures: 1020 -> 3 read as -1017 counts; the 10 bits read from a byte boundary.
+TEST(DialProfiles, AbsoluteWrappingRzAndAbsoluteZ) {
+  const std::vector<std::uint8_t> desc = {
+      0x05, 0x01,              // Usage Page (Generic Desktop)
+      0x09, 0x08,              // Usage (Multi-axis Controller)
+      0xa1, 0x01,              // Collection (Application)
+      0x05, 0x09,              //   Usage Page (Button)
+      0x19, 0x01,              //   Usage Minimum (1)
+      0x29, 0x06,              //   Usage Maximum (6)
+      0x15, 0x00,              //   Logical Minimum (0)
+      0x25, 0x01,              //   Logical Maximum (1)
+      0x75, 0x01, 0x95, 0x06,  //   Report Size (1), Report Count (6)
+      0x81, 0x02,              //   Input (Data, Variable, Absolute)
+      0x05, 0x01,              //   Usage Page (Generic Desktop)
+      0x09, 0x35,              //   Usage (Rz)
+      0x15, 0x00,              //   Logical Minimum (0)
+      0x26, 0xff, 0x03,        //   Logical Maximum (1023)
+      0x75, 0x0a, 0x95, 0x01,  //   Report Size (10), Report Count (1)
+      0x81, 0x0a,              //   Input (Data, Variable, Absolute, Wrap)
+      0x09, 0x32,              //   Usage (Z)
+      0x26, 0xff, 0x00,        //   Logical Maximum (255)
+      0x75, 0x08,              //   Report Size (8)
+      0x81, 0x02,              //   Input (Data, Variable, Absolute)
+      0xc0,                    // End Collection
+  };
+  auto d = DialDecoder::create(0x1234, 0x0002, desc, "knob");
+  ASSERT_TRUE(d) << d.error().describe();
+  ASSERT_EQ(d->dialCount(), 2);
+  EXPECT_EQ(d->channels()[0].usage, hid::usages::kRz);
+  EXPECT_EQ(d->channels()[0].kind, EventKind::kDialDelta);
+  EXPECT_DOUBLE_EQ(d->channels()[0].countsPerTurn, 1024) << "a wrapping axis turns once per logical range";
+  EXPECT_EQ(d->channels()[1].usage, hid::usages::kZ);
+  EXPECT_EQ(d->channels()[1].kind, EventKind::kDialAbsolute);
+  // Rz occupies bits 6..15: value v is bytes {(v & 3) << 6 | buttons, v >> 2}; Z is byte 2.
+  auto report = [](unsigned rz, std::uint8_t buttons, std::uint8_t z) {
+    return std::vector<std::uint8_t>{static_cast<std::uint8_t>(((rz & 3u) << 6) | buttons),
+                                     static_cast<std::uint8_t>(rz >> 2), z};
+  };
+  auto events = decodeAll(*d, report(1020, 0, 0));
+  ASSERT_EQ(events.size(), 1u) << "the first Rz is only a reference; Z reports where it is";
+  EXPECT_EQ(events[0].kind, EventKind::kDialAbsolute);
+  EXPECT_EQ(events[0].index, 1);
+  EXPECT_DOUBLE_EQ(events[0].value, 0);
+  events = decodeAll(*d, report(3, 0, 0));  // 1020 -> 1023 -> 0 -> 3: +7
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].index, 0);
+  EXPECT_DOUBLE_EQ(events[0].value, 7.0 / 1024);
+  events = decodeAll(*d, report(1021, 0x20, 255));  // 3 -> 1021: -6; button 6; Z at its maximum
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[0].index, 0);
+  EXPECT_DOUBLE_EQ(events[0].value, -6.0 / 1024);
+  EXPECT_EQ(events[1].kind, EventKind::kDialAbsolute);
+  EXPECT_DOUBLE_EQ(events[1].value, 1.0);
+  EXPECT_EQ(events[2].kind, EventKind::kButton);
+  EXPECT_EQ(events[2].index, 5);
+  events = decodeAll(*d, report(1021, 0x20, 255));
+  EXPECT_TRUE(events.empty()) << "nothing moved, nothing changed";
+  events = decodeAll(*d, report(509, 0x20, 255));  // 1021 -> 509: -512, half a turn, either way
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_DOUBLE_EQ(std::abs(events[0].value), 0.5);
 }
 
 TEST(VirtualDialBox, EncodedEventsDecodeBackExactly) {
