@@ -35,6 +35,10 @@ class HidProvider final : public DeviceProvider {
 /// report_descriptor): hidapi 0.13 has no call for it.
 [[nodiscard]] Result<std::vector<std::uint8_t>> readHidrawDescriptor(const std::string& devnode);
 
+/// \brief Why this process may not open a hidraw node for reading and writing, pointing at the
+/// udev rule when permissions are the reason; empty when it may.
+[[nodiscard]] std::string hidrawAccessProblem(const std::string& devnode);
+
 /// \brief Opens a hidraw node as a dial box directly (tests, `basalt record --hid PATH`).
 [[nodiscard]] Result<std::unique_ptr<DialBox>> openHidrawDialBox(const std::string& devnode, const Clock& clock);
 

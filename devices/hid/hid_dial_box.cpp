@@ -139,6 +139,13 @@ Result<std::unique_ptr<DialBox>> openHidrawDialBox(const std::string& devnode, c
       std::make_unique<HidrawDialBox>(std::move(info), std::move(*descriptor), std::move(*decoder), clock));
 }
 
+std::string hidrawAccessProblem(const std::string& devnode) {
+  if (::access(devnode.c_str(), R_OK | W_OK) == 0) return {};
+  const int e = errno;
+  if (e == EACCES || e == EPERM) return fmt::format("{}; {}", systemErrorText("cannot open", e), kUdevRuleHint);
+  return systemErrorText("cannot open", e);
+}
+
 HidProvider::HidProvider() = default;
 HidProvider::~HidProvider() = default;
 
@@ -163,9 +170,7 @@ std::vector<DeviceCandidate> HidProvider::enumerate() {
       } else {
         c.usage = fmt::format("{}: {} dial(s), {} button(s)", dialProfileName(decoder->profile()), decoder->dialCount(),
                               decoder->buttonCount());
-        if (::access(c.info.path.c_str(), R_OK | W_OK) != 0) {
-          c.problem = fmt::format("{}; {}", systemErrorText("cannot open", errno), kUdevRuleHint);
-        }
+        c.problem = hidrawAccessProblem(c.info.path);
       }
       out.push_back(std::move(c));
     }

@@ -789,7 +789,7 @@ std::vector<DeviceCandidate> V4l2Provider::enumerate() {
   std::vector<DeviceCandidate> out;
   std::vector<std::string> nodes;
   std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator("/dev", ec)) {
+  for (const auto& e : std::filesystem::directory_iterator(folder_, ec)) {
     const std::string name = e.path().filename().string();
     if (name.starts_with("video") && name.size() > 5 && std::isdigit(static_cast<unsigned char>(name[5]))) {
       nodes.push_back(e.path().string());

@@ -4,6 +4,7 @@
 /// \brief The `v4l2` backend: webcams and HDMI capture cards through Video4Linux2. Includes no
 /// kernel header: linux/videodev2.h stays in devices/v4l2/*.cpp.
 
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -69,10 +70,15 @@ struct V4l2Options {
 /// \brief The `v4l2` backend: every /dev/video* node that captures video.
 class V4l2Provider final : public DeviceProvider {
  public:
+  /// \brief Lists the video* nodes of `folder` (another folder only in tests).
+  explicit V4l2Provider(std::filesystem::path folder = "/dev") : folder_(std::move(folder)) {}
   [[nodiscard]] std::string_view backend() const override { return "v4l2"; }
   std::vector<DeviceCandidate> enumerate() override;
   Result<std::shared_ptr<VideoSource>> openVideoSource(const DeviceCandidate& candidate, const DeviceRequest& request,
                                                        const Clock& clock) override;
+
+ private:
+  std::filesystem::path folder_;
 };
 
 }  // namespace basalt::devices
