@@ -122,6 +122,14 @@ fi
 load xhci_pci
 load uvcvideo
 
+# ---- sound: ALSA's loopback card (what is played on device 0 is captured on device 1) ---------
+if load snd_aloop && wait_for 5 grep -q Loopback /proc/asound/cards; then
+  setenv BASALT_VLAB_ALSA_LOOPBACK "hw:Loopback,1,0"
+  fixture_ok alsa "snd-aloop: the default output is card Loopback, captured back on hw:Loopback,1,0"
+else
+  fixture_fail alsa "modprobe snd_aloop failed or no Loopback card appeared"
+fi
+
 # ---- uhid ---------------------------------------------------------------------------------
 if load uhid && wait_for 2 test -c /dev/uhid; then
   setenv BASALT_VLAB_UHID 1
