@@ -135,6 +135,21 @@ Error sysError(const std::string& path, std::string_view what, int e) {
   return Error(e == ENOENT ? Errc::kNotFound : Errc::kIo, systemErrorText(what, e), path);
 }
 
+/// "inputs 0 'Camera 0', 1 'HDMI 1'" (or "no input"), for an input that does not exist.
+std::string describeInputs(int fd) {
+  std::string names;
+  std::uint32_t count = 0;
+  for (std::uint32_t i = 0; i < 32; ++i) {
+    v4l2_input in{};
+    in.index = i;
+    if (xioctl(fd, VIDIOC_ENUMINPUT, &in) != 0) break;
+    names += fmt::format("{}{} '{}'", names.empty() ? "" : ", ", i, reinterpret_cast<const char*>(in.name));
+    ++count;
+  }
+  if (count == 0) return "no input";
+  return fmt::format("{} {}", count == 1 ? "only input" : "inputs", names);
+}
+
 void usbIds(const std::string& path, std::uint16_t& vendor, std::uint16_t& product) {
   // /sys/class/video4linux/videoN/device is the USB interface; its parent has idVendor.
   std::error_code ec;
@@ -250,7 +265,8 @@ class V4l2Camera final : public VideoSource {
   VideoMode mode_{};
   BufferSet* buffers_ = nullptr;  // capture thread (and open/close) only
   std::shared_ptr<FramePool> pool_;
-  std::mutex controlMutex_;  // S_CTRL from the manager thread vs renegotiation
+  std::mutex controlMutex_;     // S_CTRL from the manager thread vs renegotiation
+  bool qualityWarned_ = false;  // guarded by controlMutex_
 };
 
 Result<void> V4l2Camera::doOpen() {
@@ -274,9 +290,14 @@ Result<void> V4l2Camera::doOpen() {
   int input = options_.input;
   if (const int c = controls().input; c >= 0) input = c;
   if (input >= 0 && xioctl(fd_.get(), VIDIOC_S_INPUT, &input) != 0) {
-    const Error e = sysError(path_, fmt::format("cannot select input {}", input), errno);
+    const int e = errno;
+    const Error error =
+        e == EINVAL
+            ? Error(Errc::kNotFound,
+                    fmt::format("there is no input {}; the device has {}", input, describeInputs(fd_.get())), path_)
+            : sysError(path_, fmt::format("cannot select input {}", input), e);
     fd_.reset();
-    return std::unexpected(e);
+    return std::unexpected(error);
   }
   int current = 0;
   xioctl(fd_.get(), VIDIOC_G_INPUT, &current);
@@ -618,8 +639,19 @@ Result<void> V4l2Camera::doApplyControls(const VideoControls& controls) {
     q.id = V4L2_CID_JPEG_COMPRESSION_QUALITY;
     q.value = controls.quality;
     if (xioctl(fd_.get(), VIDIOC_S_CTRL, &q) != 0) {
-      static log::Once once;
-      if (once.first()) log::warn(kLogV4l2, "{}: the device has no JPEG quality control; quality ignored", path_);
+      // Said once per camera (a show may ask every camera for a quality), and only "no control"
+      // when the driver says so: a busy or failing device gets its own reason.
+      const int e = errno;
+      if (!qualityWarned_) {
+        qualityWarned_ = true;
+        if (e == EINVAL) {
+          log::warn(kLogV4l2, "{}: the device has no JPEG quality control; quality {} ignored", path_,
+                    controls.quality);
+        } else {
+          log::warn(kLogV4l2, "{}: {}; quality {} ignored", path_, systemErrorText("cannot set the JPEG quality", e),
+                    controls.quality);
+        }
+      }
     }
   }
   if (controls.input >= 0 && fd_) {
