@@ -19,10 +19,12 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <mutex>
 #include <thread>
 
 #include "devices/device_manager.h"
 #include "devices/hid/hid_backend.h"
+#include "devices/libcamera/libcamera_camera.h"
 #include "devices/udev/udev_monitor.h"
 #include "devices/v4l2/v4l2_camera.h"
 #include "sim/vlab/uvc/usb_powermate.h"
@@ -263,6 +265,66 @@ TEST(HotplugHardware, UvcGadgetUnpluggedAndReplugged) {
   ASSERT_TRUE(d) << d.error().describe();
   m.name = d->card;  // the node may get another number after the replug: match by name
   hotplugRoundTrip(DeviceKind::kVideoSource, gadget("uvc"), m, std::make_unique<V4l2Provider>());
+}
+
+/// Passes everything to the libcamera backend and keeps the hotplug events its signals send.
+class RecordingLibcameraProvider final : public DeviceProvider {
+ public:
+  explicit RecordingLibcameraProvider(std::shared_ptr<std::vector<HotplugEvent>> seen) : seen_(std::move(seen)) {}
+  [[nodiscard]] std::string_view backend() const override { return inner_.backend(); }
+  std::vector<DeviceCandidate> enumerate() override { return inner_.enumerate(); }
+  Result<std::shared_ptr<VideoSource>> openVideoSource(const DeviceCandidate& c, const DeviceRequest& r,
+                                                       const Clock& clock) override {
+    return inner_.openVideoSource(c, r, clock);
+  }
+  void watchHotplug(const std::function<void(HotplugEvent)>& notify) override {
+    inner_.watchHotplug([seen = seen_, mutex = mutex_, notify](HotplugEvent e) {
+      {
+        std::lock_guard lock(*mutex);
+        seen->push_back(e);
+      }
+      notify(std::move(e));
+    });
+  }
+  [[nodiscard]] std::shared_ptr<std::mutex> mutex() const { return mutex_; }
+
+ private:
+  LibcameraProvider inner_;
+  std::shared_ptr<std::vector<HotplugEvent>> seen_;
+  std::shared_ptr<std::mutex> mutex_ = std::make_shared<std::mutex>();  // guards *seen_
+};
+
+// The UVC camera through libcamera, unplugged and plugged in again while it streams: libcamera's
+// cameraRemoved and cameraAdded signals reach the DeviceManager, which reports it lost and brings
+// it back live without a restart. Example failures: a Camera whose disconnected signal is never
+// connected (the stream stays "live" with no frames); a replugged camera that libcamera announces
+// but Basalt never reopens.
+TEST(HotplugHardware, LibcameraUvcUnpluggedAndReplugged) {
+  if (!test::vlabEnv("BASALT_VLAB_V4L2_UVC") || !test::vlabEnv("BASALT_VLAB_GADGET_CTL")) {
+    GTEST_SKIP() << test::needsVlab("BASALT_VLAB_V4L2_UVC and BASALT_VLAB_GADGET_CTL");
+  }
+  std::string model;
+  {
+    LibcameraProvider probe;
+    if (!probe.startError().empty()) GTEST_SKIP() << probe.startError();
+    const auto cameras = probe.enumerate();
+    if (cameras.empty()) GTEST_SKIP() << "libcamera sees no camera, not even the lab's UVC camera";
+    model = cameras.front().info.name;
+  }
+  DeviceMatch m;
+  m.backend = "libcamera";
+  m.name = model;
+  auto seen = std::make_shared<std::vector<HotplugEvent>>();
+  auto provider = std::make_unique<RecordingLibcameraProvider>(seen);
+  const auto mutex = provider->mutex();
+  hotplugRoundTrip(DeviceKind::kVideoSource, gadget("uvc"), m, std::move(provider));
+  std::lock_guard lock(*mutex);
+  const auto has = [&](HotplugEvent::Action a) {
+    return std::any_of(seen->begin(), seen->end(),
+                       [&](const HotplugEvent& e) { return e.action == a && e.subsystem == "libcamera"; });
+  };
+  EXPECT_TRUE(has(HotplugEvent::Action::kRemoved)) << "no cameraRemoved signal for the unplug";
+  EXPECT_TRUE(has(HotplugEvent::Action::kAdded)) << "no cameraAdded signal for the replug";
 }
 
 // vivid's webcam instance unbound from its driver and bound again while Basalt streams it (what
