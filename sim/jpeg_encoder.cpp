@@ -1,11 +1,20 @@
-#include "sim/vlab/uvc/jpeg_encoder.h"
+#include "sim/jpeg_encoder.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <span>
 
-namespace basalt::sim::vlab {
+namespace basalt::sim {
+
+void Yuv422Planes::resize(std::uint32_t w, std::uint32_t h) {
+  width = w;
+  height = h;
+  y.resize(std::size_t{w} * h);
+  cb.resize(std::size_t{w / 2} * h);
+  cr.resize(std::size_t{w / 2} * h);
+}
+
 namespace {
 
 // ITU-T T.81 Annex K.1: the example quantisation tables, natural order.
@@ -320,4 +329,4 @@ void expandToFullRange(Yuv422Planes& planes) {
   for (auto& v : planes.cr) v = kTables[1][v];
 }
 
-}  // namespace basalt::sim::vlab
+}  // namespace basalt::sim

@@ -1,10 +1,10 @@
 #pragma once
 
 /// \file
-/// \brief A small baseline JPEG encoder for the lab camera's MJPEG frames: Y'CbCr 4:2:2 (as
-/// UVC webcams send), the quantisation tables of the JPEG standard scaled by a quality as IJG
-/// does, its typical Huffman tables, a JFIF header and the Huffman tables in every frame, so that
-/// each frame is a complete JPEG file any decoder reads.
+/// \brief A small baseline JPEG encoder for the MJPEG frames of Basalt's simulated cameras (the
+/// synthetic camera and the virtual lab's UVC webcam): Y'CbCr 4:2:2 (as UVC webcams send), the quantisation tables of
+/// the JPEG standard scaled by a quality as IJG does, its typical Huffman tables, a JFIF header and the Huffman tables
+/// in every frame, so that each frame is a complete JPEG file any decoder reads.
 
 #include <array>
 #include <cstdint>
@@ -14,9 +14,19 @@
 #include <string_view>
 #include <vector>
 
-#include "sim/vlab/uvc/test_picture.h"
+namespace basalt::sim {
 
-namespace basalt::sim::vlab {
+/// \brief A picture in planar Y'CbCr 4:2:2 (BT.601): `y` is width x height, `cb` and `cr` are
+/// width/2 x height. Drawn pictures are limited range; the encoder takes full range.
+struct Yuv422Planes {
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  std::vector<std::uint8_t> y;
+  std::vector<std::uint8_t> cb;
+  std::vector<std::uint8_t> cr;
+
+  void resize(std::uint32_t w, std::uint32_t h);
+};
 
 /// \brief Encodes 4:2:2 pictures. Holds only its tables, so encoding allocates nothing once the
 /// output vector has grown to a frame's size.
@@ -64,4 +74,4 @@ std::optional<JpegInfo> inspectJpeg(std::span<const std::uint8_t> jpeg);
 /// \brief Converts limited-range (16-235, 16-240) planes to the full range JFIF expects.
 void expandToFullRange(Yuv422Planes& planes);
 
-}  // namespace basalt::sim::vlab
+}  // namespace basalt::sim

@@ -12,7 +12,7 @@
 #include <map>
 
 #include "media/image_io.h"
-#include "sim/vlab/uvc/jpeg_encoder.h"
+#include "sim/jpeg_encoder.h"
 #include "sim/vlab/uvc/test_picture.h"
 #include "support/test_paths.h"
 

@@ -28,8 +28,8 @@
 
 #include "runtime/unique_fd.h"
 #include "sim/hid_recording.h"
+#include "sim/jpeg_encoder.h"
 #include "sim/vlab/uhid_device.h"
-#include "sim/vlab/uvc/jpeg_encoder.h"
 #include "sim/vlab/uvc/test_picture.h"
 #include "sim/vlab/uvc/uvc_camera.h"
 #include "support/process.h"
@@ -420,7 +420,7 @@ TEST(LabUvc, StreamsMjpegFramesThatAreWholeJpegs) {
   ASSERT_EQ(frames.size(), 4U) << data.size() << " bytes";
   std::optional<std::uint32_t> last;
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    const auto info = sim::vlab::inspectJpeg(frames[i]);
+    const auto info = sim::inspectJpeg(frames[i]);
     ASSERT_TRUE(info) << "frame " << i << " is not a JPEG file";
     EXPECT_TRUE(info->complete) << "frame " << i << " does not end with EOI";
     EXPECT_EQ(info->width, 640U);
@@ -514,7 +514,7 @@ TEST(LabLibcamera, CamListsAndCapturesTheUvcCamera) {
   std::optional<std::uint32_t> last;
   for (const auto& f : files) {
     const auto data = readBytes(f);
-    const auto info = sim::vlab::inspectJpeg(data);
+    const auto info = sim::inspectJpeg(data);
     ASSERT_TRUE(info) << f << " is not the camera's MJPEG frame (cam's default is its largest MJPEG size)";
     const auto number = sim::vlab::mjpegFrameNumber(data);
     ASSERT_TRUE(number) << f;

@@ -66,14 +66,6 @@ void fillRect(Yuv422Planes& p, std::uint32_t x, std::uint32_t y, std::uint32_t w
 
 }  // namespace
 
-void Yuv422Planes::resize(std::uint32_t w, std::uint32_t h) {
-  width = w;
-  height = h;
-  y.resize(std::size_t{w} * h);
-  cb.resize(std::size_t{w / 2} * h);
-  cr.resize(std::size_t{w / 2} * h);
-}
-
 CounterLayout CounterLayout::forSize(std::uint32_t width, std::uint32_t height) {
   CounterLayout l;
   const std::uint32_t cell = std::max<std::uint32_t>(8, (width / 40) / 8 * 8);

@@ -18,20 +18,9 @@
 
 #include "runtime/error.h"
 #include "runtime/image.h"
+#include "sim/jpeg_encoder.h"
 
 namespace basalt::sim::vlab {
-
-/// \brief A picture in planar Y'CbCr 4:2:2 (BT.601, limited range): `y` is width x height,
-/// `cb` and `cr` are width/2 x height.
-struct Yuv422Planes {
-  std::uint32_t width = 0;
-  std::uint32_t height = 0;
-  std::vector<std::uint8_t> y;
-  std::vector<std::uint8_t> cb;
-  std::vector<std::uint8_t> cr;
-
-  void resize(std::uint32_t w, std::uint32_t h);
-};
 
 /// \brief Where the counter cells are in a picture of a given size.
 struct CounterLayout {

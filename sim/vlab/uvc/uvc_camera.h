@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "runtime/error.h"
-#include "sim/vlab/uvc/jpeg_encoder.h"
+#include "sim/jpeg_encoder.h"
 #include "sim/vlab/uvc/test_picture.h"
 #include "sim/vlab/uvc/usb_device.h"
 
