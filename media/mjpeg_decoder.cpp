@@ -43,6 +43,7 @@ struct MjpegDecoder::Impl {
   Pipeline pipeline;
   GstElement* src = nullptr;   // borrowed
   GstElement* sink = nullptr;  // borrowed
+  GstElement* dec = nullptr;   // borrowed
 
   // Sequence numbers and capture times do not survive the decoder: they are looked up by pts.
   struct Stamp {
@@ -54,6 +55,7 @@ struct MjpegDecoder::Impl {
   std::condition_variable decodedCv;
   std::array<Stamp, 32> stamps{};  // guarded by mutex
   std::size_t nextStamp = 0;       // guarded by mutex
+  std::thread::id decodeThread;    // guarded by mutex
   CapsPtr lastCaps;                // streaming thread only; held so that its address stays its own
   GstVideoInfo info{};             // streaming thread only
   std::atomic<std::uint64_t> decoded{0};
@@ -90,6 +92,7 @@ struct MjpegDecoder::Impl {
     queue.pushDroppingOldest(std::move(frame));
     {
       std::lock_guard lock(mutex);  // so that a waiter cannot miss the notification
+      decodeThread = std::this_thread::get_id();
       decoded.fetch_add(1, std::memory_order_relaxed);
     }
     decodedCv.notify_all();
@@ -114,7 +117,8 @@ Result<std::unique_ptr<MjpegDecoder>> MjpegDecoder::create(MjpegDecoderOptions o
   impl->src = impl->pipeline.child("src");
   impl->sink = impl->pipeline.child("sink");
   // A damaged JPEG is dropped, never fatal: a camera glitch must not end the stream.
-  if (GstElement* dec = impl->pipeline.child("dec")) g_object_set(dec, "max-errors", -1, nullptr);
+  impl->dec = impl->pipeline.child("dec");
+  if (impl->dec) g_object_set(impl->dec, "max-errors", -1, nullptr);
   GstAppSinkCallbacks callbacks{};
   callbacks.new_sample = [](GstAppSink*, gpointer data) { return static_cast<Impl*>(data)->onSample(); };
   gst_app_sink_set_callbacks(reinterpret_cast<GstAppSink*>(impl->sink), &callbacks, impl.get(), nullptr);
@@ -124,12 +128,24 @@ Result<std::unique_ptr<MjpegDecoder>> MjpegDecoder::create(MjpegDecoderOptions o
       [](GstBus*, GstMessage* message, gpointer data) {
         auto* self = static_cast<Impl*>(data);
         const GstMessageType type = GST_MESSAGE_TYPE(message);
-        if (type == GST_MESSAGE_WARNING || type == GST_MESSAGE_ERROR) {
-          self->corrupt.fetch_add(1, std::memory_order_relaxed);
+        // jpegdec drops a JPEG it cannot read with a QoS message (with max-errors = -1 it posts
+        // no warning since GStreamer 1.16 or so); nothing else makes it drop here, as the sink
+        // does not sync to a clock. Posted on the streaming thread: waiters are woken.
+        const bool dropped =
+            type == GST_MESSAGE_QOS && GST_MESSAGE_SRC(message) == reinterpret_cast<GstObject*>(self->dec);
+        if (dropped) {
+          {
+            std::lock_guard lock(self->mutex);
+            self->corrupt.fetch_add(1, std::memory_order_relaxed);
+          }
+          self->decodedCv.notify_all();
+        }
+        if (dropped || type == GST_MESSAGE_WARNING || type == GST_MESSAGE_ERROR) {
           static log::Once once;
           if (once.first()) {
-            log::warn(kLogMedia, "{}: a JPEG frame could not be decoded ({}); such frames are dropped",
-                      self->options.name, describeGstMessage(message));
+            log::warn(kLogMedia, "{}: a JPEG frame could not be decoded ({}); such frames are dropped and counted",
+                      self->options.name,
+                      dropped ? std::string("the decoder dropped it") : describeGstMessage(message));
           }
         }
         return GST_BUS_DROP;  // nobody reads this bus: keep it from growing
@@ -170,6 +186,18 @@ bool MjpegDecoder::waitForDecoded(std::uint64_t count, std::chrono::milliseconds
   std::unique_lock lock(impl_->mutex);
   return impl_->decodedCv.wait_for(lock, timeout,
                                    [this, count] { return impl_->decoded.load(std::memory_order_relaxed) >= count; });
+}
+
+bool MjpegDecoder::waitForFinished(std::uint64_t count, std::chrono::milliseconds timeout) {
+  std::unique_lock lock(impl_->mutex);
+  return impl_->decodedCv.wait_for(lock, timeout, [this, count] {
+    return impl_->decoded.load(std::memory_order_relaxed) + impl_->corrupt.load(std::memory_order_relaxed) >= count;
+  });
+}
+
+std::thread::id MjpegDecoder::decodeThread() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->decodeThread;
 }
 
 std::uint64_t MjpegDecoder::decoded() const { return impl_->decoded.load(std::memory_order_relaxed); }

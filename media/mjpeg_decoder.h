@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "runtime/error.h"
 #include "runtime/frame.h"
@@ -40,11 +41,17 @@ class MjpegDecoder final : public FrameSource {
   FrameRef frameAt(Nanos showTime) override;
   /// \brief For tests and offline tools: waits until `count` frames have been decoded in all.
   bool waitForDecoded(std::uint64_t count, std::chrono::milliseconds timeout);
+  /// \brief For offline runs (a ManualClock show): waits until the decoder is done with `count`
+  /// JPEGs in all, decoded or found corrupt, so that the frame due is the one pushed last.
+  bool waitForFinished(std::uint64_t count, std::chrono::milliseconds timeout);
 
   [[nodiscard]] std::uint64_t decoded() const;
   [[nodiscard]] std::uint64_t dropped() const;
   /// \brief JPEGs the decoder could not read.
   [[nodiscard]] std::uint64_t corrupt() const;
+  /// \brief The thread the last frame was decoded on (GStreamer's streaming thread, never the
+  /// caller of push() or frameAt()); a default id before the first. For tests.
+  [[nodiscard]] std::thread::id decodeThread() const;
 
  private:
   struct Impl;

@@ -34,13 +34,14 @@ Result<void> applyCameraOptions(const devices::DeviceRequest& request, Synthetic
   const std::string format = optionOr(request, "format", "");
   if (!format.empty()) {
     PixelFormat f = PixelFormat::kUnknown;
-    for (int i = 1; i < static_cast<int>(PixelFormat::kMjpeg); ++i) {
+    for (int i = 1; i <= static_cast<int>(PixelFormat::kMjpeg); ++i) {
       if (pixelFormatName(static_cast<PixelFormat>(i)) == format) f = static_cast<PixelFormat>(i);
     }
     if (f == PixelFormat::kUnknown) {
       return fail(
           Errc::kInvalidArgument,
-          fmt::format("format '{}' is not one of RGBA, BGRA, RGB, GRAY8, I420, YV12, NV12, NV21, YUYV, UYVY", format),
+          fmt::format("format '{}' is not one of RGBA, BGRA, RGB, GRAY8, I420, YV12, NV12, NV21, YUYV, UYVY, MJPEG",
+                      format),
           where(request));
     }
     config.mode.format = f;
@@ -82,7 +83,7 @@ Result<void> applyCameraOptions(const devices::DeviceRequest& request, Synthetic
   auto moving = boolOption(request, "moving", config.moving);
   if (!moving) return std::unexpected(moving.error());
   config.moving = *moving;
-  // "unplug@NS,signal_lost@NS+NS,stall@NS+NS": times in nanoseconds after opening.
+  // "unplug@NS,signal_lost@NS+NS,stall@NS+NS,corrupt@NS": times in nanoseconds after opening.
   const std::string faults = optionOr(request, "faults", "");
   std::string_view rest = faults;
   while (!rest.empty()) {
@@ -100,8 +101,8 @@ Result<void> applyCameraOptions(const devices::DeviceRequest& request, Synthetic
     std::int64_t time = 0;
     std::int64_t length = 0;
     bool ok = at != std::string_view::npos;
-    if (kind == "unplug") {
-      f.kind = CameraFault::Kind::kUnplug;
+    if (kind == "unplug" || kind == "corrupt") {
+      f.kind = kind == "corrupt" ? CameraFault::Kind::kCorrupt : CameraFault::Kind::kUnplug;
       ok = ok && plus == std::string_view::npos && number(item.substr(at + 1), time);
     } else if (kind == "signal_lost" || kind == "stall") {
       f.kind = kind == "stall" ? CameraFault::Kind::kStall : CameraFault::Kind::kSignalLost;
@@ -112,7 +113,13 @@ Result<void> applyCameraOptions(const devices::DeviceRequest& request, Synthetic
     }
     if (!ok) {
       return fail(Errc::kInvalidArgument,
-                  fmt::format("fault '{}' is not unplug@NS, signal_lost@NS+NS or stall@NS+NS", item), where(request));
+                  fmt::format("fault '{}' is not unplug@NS, signal_lost@NS+NS, stall@NS+NS or corrupt@NS", item),
+                  where(request));
+    }
+    if (f.kind == CameraFault::Kind::kCorrupt && config.mode.format != PixelFormat::kMjpeg) {
+      return fail(Errc::kInvalidArgument,
+                  fmt::format("fault '{}': only MJPEG frames can be corrupt (format = \"MJPEG\")", item),
+                  where(request));
     }
     f.time = Nanos{time};
     f.duration = Nanos{length};

@@ -24,8 +24,8 @@ namespace basalt::sim {
 /// demo turns) and one camera ("synthetic:camera", 640x360 YUYV colour bars at 30 fps).
 ///
 /// Request options it reads: dial boxes `loop` (true/false); cameras `format` (YUYV, NV12,
-/// I420, RGBA, ...), `size` (WxH), `fps`, `pattern` (bars, gradient, checker, solid), `moving`
-/// (true/false), `faults` (see applyCameraOptions).
+/// I420, RGBA, ..., or MJPEG: JPEG-encoded 4:2:2 like a webcam's), `size` (WxH), `fps`, `pattern` (bars, gradient,
+/// checker, solid), `moving` (true/false), `faults` (see applyCameraOptions).
 ///
 /// Tests plug and unplug devices with plug()/unplug(): an unplugged device's live object fails
 /// its next read, and a device plugged at the same path may be a different one.
@@ -71,7 +71,8 @@ class SyntheticProvider final : public devices::DeviceProvider {
 };
 
 /// \brief Applies a camera request's options (format, size, fps, pattern, moving, faults:
-/// "unplug@NS,signal_lost@NS+NS,stall@NS+NS" in nanoseconds after opening) to `config`.
+/// "unplug@NS,signal_lost@NS+NS,stall@NS+NS,corrupt@NS" in nanoseconds after opening; corrupt,
+/// MJPEG only, damages the frame due then) to `config`.
 [[nodiscard]] Result<void> applyCameraOptions(const devices::DeviceRequest& request, SyntheticCameraConfig& config);
 
 /// \brief The `replay` backend: the devices recorded in trace folders and hid-recorder files.

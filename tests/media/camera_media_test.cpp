@@ -79,6 +79,7 @@ TEST(MjpegDecoder, DamagedJpegIsDroppedAndTheStreamGoesOn) {
   ASSERT_TRUE(f);
   EXPECT_EQ(test::readFrameNumber(*f), 42);
   EXPECT_EQ(f->sequence, 2u);
+  EXPECT_EQ((*decoder)->corrupt(), 1u) << "the damaged JPEG is counted";
 }
 
 TEST(MjpegDecoder, RefusesFramesThatAreNotJpeg) {
