@@ -20,6 +20,7 @@
 #include <fmt/std.h>
 
 #include "kiosk/time_zone.h"
+#include "runtime/frame.h"
 #include "sim/hid_recording.h"
 
 namespace basalt::kiosk {
@@ -1002,7 +1003,7 @@ class Reader {
       d.line = lineOf(*t);
       checkKeys(*t, path,
                 {"kind", "backend", "match", "trace", "script", "loop", "required", "size", "gain", "acceleration",
-                 "mirror", "faults"});
+                 "mirror", "faults", "format"});
       const auto kind =
           choice<DeviceKind>(*t, "kind", path, {{"dial_box", DeviceKind::kDialBox}, {"camera", DeviceKind::kCamera}});
       if (!t->get("kind")) error(d.line, fmt::format("{}: needs kind = \"dial_box\" or \"camera\"", path));
@@ -1095,6 +1096,22 @@ class Reader {
           warning(lineOf(*t->get("mirror")), fmt::format("{}.mirror: only cameras mirror; this is ignored", path));
         }
       }
+      if (auto format = string(*t, "format", path)) {
+        bool known = false;
+        for (int i = 1; i <= static_cast<int>(PixelFormat::kMjpeg); ++i) {
+          known = known || pixelFormatName(static_cast<PixelFormat>(i)) == *format;
+        }
+        if (!known) {
+          error(lineOf(*t->get("format")),
+                fmt::format("{}.format: '{}' is not one of RGBA, BGRA, RGB, GRAY8, I420, YV12, NV12, NV21, YUYV, "
+                            "UYVY, MJPEG",
+                            path, *format));
+        } else if (d.kind != DeviceKind::kCamera) {
+          warning(lineOf(*t->get("format")), fmt::format("{}.format: only cameras have a format", path));
+        } else {
+          d.format = *format;
+        }
+      }
       if (const toml::node* faults = t->get("faults")) {
         if (d.kind != DeviceKind::kCamera || d.backend != DeviceBackend::kSynthetic) {
           warning(lineOf(*faults), fmt::format("{}.faults: only synthetic cameras play faults; this is ignored", path));
@@ -1177,12 +1194,18 @@ class Reader {
       const auto kind = choice<SyntheticFault::Kind>(*t, "fault", ip,
                                                      {{"unplug", SyntheticFault::Kind::kUnplug},
                                                       {"signal_lost", SyntheticFault::Kind::kSignalLost},
-                                                      {"stall", SyntheticFault::Kind::kStall}});
-      if (!t->get("fault"))
-        error(lineOf(*t), fmt::format("{}: needs fault = \"unplug\", \"signal_lost\" or \"stall\"", ip));
+                                                      {"stall", SyntheticFault::Kind::kStall},
+                                                      {"corrupt", SyntheticFault::Kind::kCorrupt}});
+      if (!t->get("fault")) {
+        error(lineOf(*t), fmt::format("{}: needs fault = \"unplug\", \"signal_lost\", \"stall\" or \"corrupt\"", ip));
+      }
       if (kind) f.kind = *kind;
       if (auto length = duration(*t, "for", ip)) f.duration = *length;
-      if (kind && *kind != SyntheticFault::Kind::kUnplug && !t->get("for")) {
+      if (kind && *kind == SyntheticFault::Kind::kCorrupt && d.format != "MJPEG") {
+        error(lineOf(*t), fmt::format("{}: only MJPEG frames can be corrupt (format = \"MJPEG\")", ip));
+      }
+      if (kind && (*kind == SyntheticFault::Kind::kSignalLost || *kind == SyntheticFault::Kind::kStall) &&
+          !t->get("for")) {
         error(lineOf(*t), fmt::format("{}: needs for = \"TIME\" (how long it lasts)", ip));
       }
       d.faults.push_back(f);

@@ -179,7 +179,8 @@ struct SyntheticInput {
 
 /// \brief A scripted fault of a synthetic camera (tests and demos of the fallbacks).
 struct SyntheticFault {
-  enum class Kind : std::uint8_t { kUnplug, kSignalLost, kStall };
+  /// corrupt: one damaged JPEG (MJPEG cameras only)
+  enum class Kind : std::uint8_t { kUnplug, kSignalLost, kStall, kCorrupt };
   Nanos at{0};  ///< after the camera opens
   Kind kind = Kind::kUnplug;
   Nanos duration{0};  ///< signal_lost and stall
@@ -198,6 +199,7 @@ struct DeviceSpec {
   std::optional<std::uint32_t> width;  ///< camera: requested size
   std::optional<std::uint32_t> height;
   bool mirror = false;                 ///< camera: flip left-right (in the device, else the renderer)
+  std::string format;                  ///< camera: "MJPEG", "YUYV", ... asked of the device (empty: any)
   std::vector<SyntheticFault> faults;  ///< synthetic camera: what goes wrong, when
   double gain = 1;                     ///< dial box: multiplies every dial's gain
   double acceleration = 0;             ///< dial box: every dial's acceleration unless a binding says otherwise

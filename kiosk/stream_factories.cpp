@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <mutex>
+#include <thread>
 
 #include <fmt/format.h>
 #include <fmt/std.h>
@@ -15,6 +16,7 @@
 #include "devices/libcamera/libcamera_camera.h"
 #include "devices/serial/sgi_dial_box.h"
 #include "devices/v4l2/v4l2_camera.h"
+#include "media/mjpeg_decoder.h"
 #include "media/movie_player.h"
 #include "render/stream_texture.h"
 #include "runtime/log.h"
@@ -200,6 +202,52 @@ Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, c
 // ---------------------------------------------------------------------------------------------
 // Cameras
 
+/// A camera's MJPEG frames, decoded off the frame loop: the device manager's frame tap hands
+/// every JPEG the camera delivers to a media::MjpegDecoder on the producer's thread (the
+/// manager's or the backend's capture thread; the frame loop's only under a ManualClock, where
+/// the manager is stepped there), and GStreamer decodes it on its streaming thread. The decoder is
+/// made for the first JPEG; one that cannot be made is kept as the failure.
+class MjpegTap final : public devices::FrameTap {
+ public:
+  explicit MjpegTap(std::string camera) : camera_(std::move(camera)) {}
+
+  void onFrame(DeviceId /*device*/, const FrameRef& frame) override {
+    if (!frame || frame->format != PixelFormat::kMjpeg) return;
+    std::shared_ptr<media::MjpegDecoder> decoder;
+    {
+      std::lock_guard lock(mutex_);
+      if (!decoder_ && failure_.empty()) {
+        auto made = media::MjpegDecoder::create({3, fmt::format("camera '{}'", camera_)});
+        if (made) {
+          decoder_ = std::move(*made);
+        } else {
+          failure_ = made.error().describe();
+        }
+      }
+      decoder = decoder_;
+    }
+    if (decoder && decoder->push(frame)) pushed_.fetch_add(1, std::memory_order_release);
+  }
+
+  [[nodiscard]] std::shared_ptr<media::MjpegDecoder> decoder() const {
+    std::lock_guard lock(mutex_);
+    return decoder_;
+  }
+  [[nodiscard]] std::string failure() const {
+    std::lock_guard lock(mutex_);
+    return failure_;
+  }
+  /// JPEGs handed to the decoder so far.
+  [[nodiscard]] std::uint64_t pushed() const { return pushed_.load(std::memory_order_acquire); }
+
+ private:
+  std::string camera_;
+  mutable std::mutex mutex_;
+  std::shared_ptr<media::MjpegDecoder> decoder_;  // guarded by mutex_
+  std::string failure_;                           // guarded by mutex_
+  std::atomic<std::uint64_t> pushed_{0};
+};
+
 class CameraStream final : public TextureStream {
  public:
   CameraStream(const MediaSpec& media, std::unique_ptr<devices::DeviceProvider> provider,
@@ -209,8 +257,10 @@ class CameraStream final : public TextureStream {
         lossColour_(media.lossColour),
         clock_(clock),
         events_(256),
+        mjpeg_(request.name),
         manager_(clock, events_),
         name_(request.name) {
+    manager_.setTaps(nullptr, &mjpeg_);
     manager_.addProvider(std::move(provider));
     requested_ = manager_.request(std::move(request)).has_value();
     stream_ = manager_.videoStream(name_);
@@ -242,9 +292,28 @@ class CameraStream final : public TextureStream {
     }
     // A camera that cannot flip in the device is mirrored by its texture.
     texture_->setMirror(stream_->mirrorInRenderer());
-    const FrameRef frame = stream_->frameAt(showTime);
+    FrameRef frame = stream_->frameAt(showTime);
     state_ = stream_->health().state;
     if (state_ != SourceState::kLive) return showLoss(textures);
+    const std::optional<devices::VideoMode> mode = stream_->mode();
+    if ((frame && frame->format == PixelFormat::kMjpeg) || (mode && mode->format == PixelFormat::kMjpeg)) {
+      // The JPEG went to the decoder when the camera delivered it (MjpegTap): show the newest
+      // decoded frame due. A ManualClock run waits for the decoder, so that every run is exact.
+      if (const std::string failure = mjpeg_.failure(); !failure.empty()) {
+        if (!reportedMjpegFailure_) {
+          reportedMjpegFailure_ = true;
+          log::error(kLogStreams,
+                     "camera '{}' delivers MJPEG, which cannot be decoded: {}; its textures show their "
+                     "fallback",
+                     name_, failure);
+        }
+        return false;
+      }
+      const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_.decoder();
+      if (!decoder) return false;
+      if (clock_.isManual()) (void)decoder->waitForFinished(mjpeg_.pushed(), std::chrono::seconds(10));
+      frame = decoder->frameAt(showTime);
+    }
     auto changed = texture_->update(frame);
     if (!changed) {
       log::warn(kLogStreams, "camera '{}': {}", media_, changed.error().describe());
@@ -318,8 +387,8 @@ class CameraStream final : public TextureStream {
     for (const devices::DeviceStatus& s : manager_.status()) {
       if (s.name != name_) continue;
       if (s.state == devices::DeviceState::kLive) {
-        return fmt::format("camera {}: {}{}", devices::describeDevice(s.device),
-                           s.mode ? devices::describeMode(*s.mode) : std::string("live"),
+        return fmt::format("camera {}: {}{}{}", devices::describeDevice(s.device),
+                           s.mode ? devices::describeMode(*s.mode) : std::string("live"), describeMjpeg(),
                            texture_ && texture_->mirror() ? ", mirrored by the renderer" : "");
       }
       return fmt::format("camera '{}' ({}) is {}: {}; showing {}", name_, s.match, devices::deviceStateName(s.state),
@@ -328,7 +397,27 @@ class CameraStream final : public TextureStream {
     return fmt::format("camera '{}' was not requested", name_);
   }
 
+  /// For tests: the thread the camera's JPEGs are decoded on; none before the first.
+  [[nodiscard]] std::optional<std::thread::id> mjpegDecodeThread() const {
+    const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_.decoder();
+    if (!decoder || decoder->decodeThread() == std::thread::id{}) return std::nullopt;
+    return decoder->decodeThread();
+  }
+
  private:
+  /// ", JPEG decoded off the frame loop, 2 corrupt JPEGs dropped" for an MJPEG camera.
+  [[nodiscard]] std::string describeMjpeg() const {
+    if (const std::string failure = mjpeg_.failure(); !failure.empty()) {
+      return fmt::format(", MJPEG that cannot be decoded ({}); showing {}", failure, lossName());
+    }
+    const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_.decoder();
+    if (!decoder) return "";
+    const std::uint64_t corrupt = decoder->corrupt();
+    return fmt::format(
+        ", JPEG decoded off the frame loop{}",
+        corrupt == 0 ? std::string() : fmt::format(", {} corrupt JPEG{} dropped", corrupt, corrupt == 1 ? "" : "s"));
+  }
+
   std::string media_;
   CameraLoss onLoss_;
   std::array<std::uint8_t, 3> lossColour_;
@@ -338,6 +427,8 @@ class CameraStream final : public TextureStream {
   std::uint64_t patternSequence_ = 0;
   const Clock& clock_;
   BoundedQueue<Event> events_;  // state events of the manager; the status comes from status()
+  MjpegTap mjpeg_;              // before manager_: its frame tap, so it outlives the manager's threads
+  bool reportedMjpegFailure_ = false;
   devices::DeviceManager manager_;
   std::string name_;
   bool requested_ = false;
@@ -365,6 +456,7 @@ Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, 
   if (spec->backend == DeviceBackend::kReplay || spec->backend == DeviceBackend::kSynthetic) {
     request.options["loop"] = spec->loop ? "true" : "false";
   }
+  if (!spec->format.empty()) request.options["format"] = spec->format;
   request.controls.mirror = spec->mirror;
   if (spec->backend == DeviceBackend::kSynthetic && !spec->faults.empty()) {
     std::string faults;
@@ -378,6 +470,7 @@ Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, 
         case SyntheticFault::Kind::kStall:
           faults += fmt::format("stall@{}+{}", f.at.count(), f.duration.count());
           break;
+        case SyntheticFault::Kind::kCorrupt: faults += fmt::format("corrupt@{}", f.at.count()); break;
       }
     }
     request.options["faults"] = faults;
@@ -474,6 +567,11 @@ void registerShowFactories() {
     setStreamFactory(MediaKind::kCamera, makeCameraStream);
     setItemFactory(EntryKind::kMovie, makeMovieItem);
   });
+}
+
+std::optional<std::thread::id> mjpegDecodeThread(const TextureStream& stream) {
+  const auto* camera = dynamic_cast<const CameraStream*>(&stream);
+  return camera ? camera->mjpegDecodeThread() : std::nullopt;
 }
 
 }  // namespace basalt::kiosk

@@ -3,7 +3,8 @@
 /// \file
 /// \brief What fills the loader's seams (kiosk/show_loader.h): dial boxes of the hid and replay
 /// backends, and texture streams for movies (media::MoviePlayer) and cameras (devices'
-/// VideoSources: v4l2, libcamera, synthetic, replay). `registerShowFactories()` installs them;
+/// VideoSources: v4l2, libcamera, synthetic, replay; MJPEG decoded by media::MjpegDecoder off the
+/// frame loop's thread). `registerShowFactories()` installs them;
 /// runShow calls it before the first show loads, and so do tests.
 ///
 /// Who keeps a device open (ARCHITECTURE.md "Devices in shows"): a dial box of a show is
@@ -14,7 +15,9 @@
 /// device, never two.
 
 #include <memory>
+#include <optional>
 #include <string>
+#include <thread>
 
 #include "devices/device_manager.h"
 #include "kiosk/show_loader.h"
@@ -27,6 +30,10 @@ struct ScriptPlayerOptions;
 /// \brief Registers the hid and replay dial box factories and the movie and camera stream
 /// factories. Idempotent; call before the first show loads.
 void registerShowFactories();
+
+/// \brief For tests: the thread a camera stream's MJPEG frames are decoded on (never the frame
+/// loop's); none for other streams, cameras that deliver raw frames, and before the first JPEG.
+[[nodiscard]] std::optional<std::thread::id> mjpegDecodeThread(const TextureStream& stream);
 
 /// \brief The device rule for a manifest's device: its backend and match fields.
 [[nodiscard]] devices::DeviceMatch deviceMatchFor(const DeviceSpec& spec);

@@ -9,19 +9,25 @@
 // or the fallback image) shows while the synthetic camera is unplugged and the live picture
 // comes back with it; a camera asked to mirror that cannot flip is mirrored by the renderer;
 // `basalt record`'s Matroska camera video replays frame for frame, bit for bit, at the recorded
-// microsecond.
+// microsecond; a camera delivering MJPEG (the synthetic one's JPEG-encoded colour bars) shows
+// the same picture as its raw twin, decoded on another thread than the frame loop's, and a
+// corrupt JPEG is counted in its status while the next good frame shows.
 // Example failures: a factory that is never registered (streams stay "absent"); a movie texture
 // that stays on its fallback; a replayed knob whose events never reach the bindings; a missing
 // device that crashes the show or is reported without its reason; a VCR command that is ignored;
 // a lost camera that shows the fallback image whatever on_loss says; a Matroska trace whose
-// frames come back shifted, re-encoded or at millisecond times.
+// frames come back shifted, re-encoded or at millisecond times; MJPEG handed to the renderer
+// as it is (the fallback stays) or decoded on the frame loop's thread; a corrupt JPEG that ends
+// the camera's picture.
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "kiosk/frame_loop.h"
 #include "kiosk/manifest.h"
@@ -107,6 +113,8 @@ class Harness {
   runtime::Show& show() { return show_; }
   /// The last frame drawn, read back.
   [[nodiscard]] const Image& lastFrame() const { return capture_.image; }
+  /// The thread the frame loop drew the last frame on.
+  [[nodiscard]] std::thread::id loopThread() const { return capture_.thread; }
   ManualClock& clock() { return clock_; }
 
  private:
@@ -121,7 +129,9 @@ class Harness {
   std::unique_ptr<ShowDirector> director_;
   struct Capture final : FrameParticipant {
     Image image;
+    std::thread::id thread;
     Result<void> afterDraw(const FrameContext& /*frame*/, render::Output& output) override {
+      thread = std::this_thread::get_id();
       return output.readBack(image);
     }
   } capture_;
@@ -490,6 +500,101 @@ TEST(ShowStreams, ACameraThatCannotFlipIsMirroredByTheRenderer) {
       << "the synthetic camera has no hardware flip: " << camera->stream->describe();
   EXPECT_EQ(plain.texture("camera.png")->stream->describe().find("mirrored"), std::string::npos);
   EXPECT_NE(plain.lastFrame().pixels, mirrored.lastFrame().pixels) << "the sculpture shows the picture flipped";
+}
+
+/// The camera-sculpture example with a synthetic camera (160x120 colour bars) delivering
+/// `format`, with `faults` (a TOML array, or empty).
+::testing::AssertionResult installFormatShow(Harness& h, const std::string& format, const std::string& faults = "") {
+  registerContentReaders();
+  const auto example = test::sourceDir() / "configs/shows/camera-sculpture";
+  for (const char* file : {"sculpture.sce", "sculpture.obj", "camera.png"}) {
+    std::filesystem::copy_file(example / file, h.dir() / file, std::filesystem::copy_options::overwrite_existing);
+  }
+  std::ofstream(h.dir() / "show.toml") << fmt::format(R"(
+[show]
+entry = "sculpture.sce"
+[devices.camera]
+kind = "camera"
+backend = "synthetic"
+size = "160x120"
+format = "{}"
+{}
+[media.live]
+kind = "camera"
+device = "camera"
+[textures."camera.png"]
+source = "live"
+fallback = "camera.png"
+)",
+                                                      format, faults.empty() ? "" : "faults = " + faults);
+  return h.install(h.dir() / "show.toml");
+}
+
+/// Mean absolute difference of two read-back frames of the same size, per channel value.
+double meanDifference(const Image& a, const Image& b) {
+  if (a.pixels.size() != b.pixels.size() || a.pixels.empty()) return 255;
+  double sum = 0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) sum += std::abs(int{a.pixels[i]} - int{b.pixels[i]});
+  return sum / static_cast<double>(a.pixels.size());
+}
+
+/// Pixels of the colour bars' magenta and cyan as lit on the sculpture (one channel well below
+/// the other two), which the camera.png fallback and the unlit scene do not have.
+std::size_t barPixels(const Image& image) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i + 2 < image.pixels.size(); i += static_cast<std::size_t>(image.channels)) {
+    const int r = image.pixels[i], g = image.pixels[i + 1], b = image.pixels[i + 2];
+    if ((r > 50 && b > 50 && g * 2 < std::min(r, b)) || (g > 50 && b > 50 && r * 2 < std::min(g, b))) ++n;
+  }
+  return n;
+}
+
+TEST(ShowStreams, AnMjpegCameraIsDecodedOffTheFrameLoopAndShowsItsColourBars) {
+  Harness raw("mjpeg-twin-yuyv");
+  OPEN_OR_SKIP(raw);
+  ASSERT_TRUE(installFormatShow(raw, "YUYV"));
+  Harness h("mjpeg");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(installFormatShow(h, "MJPEG"));
+  raw.run(9);
+  h.run(9);
+  const LoadedTexture* camera = h.texture("camera.png");
+  ASSERT_NE(camera, nullptr);
+  ASSERT_NE(camera->stream, nullptr) << camera->streamState;
+  EXPECT_TRUE(camera->live) << camera->stream->describe();
+  EXPECT_TRUE(says(*camera, "MJPEG")) << camera->stream->describe();
+  EXPECT_TRUE(says(*camera, "JPEG decoded off the frame loop")) << camera->stream->describe();
+  EXPECT_FALSE(says(*camera, "corrupt")) << camera->stream->describe();
+  // Decoded on GStreamer's thread, not on the frame loop's (this thread under a ManualClock).
+  const std::optional<std::thread::id> decoder = mjpegDecodeThread(*camera->stream);
+  ASSERT_TRUE(decoder.has_value()) << "nothing was decoded: " << camera->stream->describe();
+  EXPECT_EQ(h.loopThread(), std::this_thread::get_id());
+  EXPECT_NE(*decoder, h.loopThread());
+  EXPECT_FALSE(mjpegDecodeThread(*raw.texture("camera.png")->stream).has_value()) << "raw frames need no decoder";
+  // The same colour bars as the raw camera's, within JPEG's loss.
+  EXPECT_GT(barPixels(h.lastFrame()), 100u) << "the sculpture shows the colour bars";
+  EXPECT_LT(meanDifference(h.lastFrame(), raw.lastFrame()), 1.0) << "the picture differs from the raw camera's";
+}
+
+TEST(ShowStreams, ACorruptJpegIsCountedAndTheNextGoodFrameShows) {
+  Harness raw("mjpeg-corrupt-twin");
+  OPEN_OR_SKIP(raw);
+  ASSERT_TRUE(installFormatShow(raw, "YUYV"));
+  Harness h("mjpeg-corrupt");
+  OPEN_OR_SKIP(h);
+  // Frame 6 (0.2 s) is damaged; the frames after it are good.
+  ASSERT_TRUE(installFormatShow(h, "MJPEG", R"([ { at = "0.2s", fault = "corrupt" } ])"));
+  const LoadedTexture* camera = h.texture("camera.png");
+  ASSERT_NE(camera, nullptr);
+  ASSERT_NE(camera->stream, nullptr) << camera->streamState;
+  h.run(12);
+  raw.run(12);
+  EXPECT_TRUE(camera->live) << camera->stream->describe();
+  EXPECT_TRUE(says(*camera, ", 1 corrupt JPEG dropped")) << camera->stream->describe();
+  EXPECT_LT(meanDifference(h.lastFrame(), raw.lastFrame()), 1.0) << "the frames after the corrupt one show";
+  const StatusSnapshot status = h.board().snapshot(h.clock().wallNow());
+  ASSERT_EQ(status.streams.size(), 1u);
+  EXPECT_EQ(status.streams[0].state, "playing") << status.streams[0].message;
 }
 
 TEST(ShowStreams, MatroskaTracesReplayTheRecordedFramesAtTheirMicrosecond) {

@@ -762,6 +762,29 @@ TEST(ManifestDevices, AHidRecorderFileReplaysAsADialBox) {
   slot.dialBox->close();
 }
 
+// Makes sure a camera's `format` reaches the device spec and the corrupt fault needs MJPEG.
+// Example failure: a misspelt format passed to the device (the camera then fails at every open
+// instead of `basalt check` naming the line), or a corrupt fault on raw frames accepted.
+TEST(ManifestCameraFormat, FormatsAndTheCorruptFault) {
+  ShowFolder f("camera-format");
+  const auto good = f.read(
+      "[devices.cam]\nkind = \"camera\"\nbackend = \"synthetic\"\nformat = \"MJPEG\"\n"
+      "faults = [ { at = \"1s\", fault = \"corrupt\" } ]\n");
+  ASSERT_TRUE(good.manifest) << good.text;
+  ASSERT_EQ(good.manifest->devices.size(), 1u);
+  EXPECT_EQ(good.manifest->devices[0].format, "MJPEG");
+  ASSERT_EQ(good.manifest->devices[0].faults.size(), 1u);
+  EXPECT_EQ(good.manifest->devices[0].faults[0].kind, SyntheticFault::Kind::kCorrupt);
+  EXPECT_EQ(good.manifest->devices[0].faults[0].at, std::chrono::seconds(1));
+
+  const auto bad = f.read(
+      "[devices.cam]\nkind = \"camera\"\nbackend = \"synthetic\"\nformat = \"JPEG\"\n"  // 1-4
+      "faults = [ { at = \"1s\", fault = \"corrupt\" } ]\n");                           // 5
+  EXPECT_FALSE(bad.manifest);
+  EXPECT_TRUE(hasError(bad, 4, "'JPEG' is not one of")) << bad.text;
+  EXPECT_TRUE(hasError(bad, 5, "only MJPEG frames can be corrupt")) << bad.text;
+}
+
 // Makes sure `[input]` (keyboards and mice from evdev) is read and checked like the rest.
 // Example failure: a misspelt mode is taken as "auto" without a word, or a name list holding a
 // number is accepted.
