@@ -22,6 +22,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -595,6 +596,58 @@ TEST(ShowStreams, ACorruptJpegIsCountedAndTheNextGoodFrameShows) {
   const StatusSnapshot status = h.board().snapshot(h.clock().wallNow());
   ASSERT_EQ(status.streams.size(), 1u);
   EXPECT_EQ(status.streams[0].state, "playing") << status.streams[0].message;
+}
+
+// LAVA's camera demonstration (manual, "Camera"): the live camera on the sculpture, its front
+// surface blended to the constant background at transparency 0.45. Makes sure each pixel of the
+// camera-textured sculpture is 55 % of the opaque picture and 45 % of the background colour, and
+// still moves with the camera. Example failures: transparency ignored on a part whose texture is
+// a stream (opaque pixels); the camera drawn at 55 % over black (no background in the mix); a
+// blend that loses the picture (a flat colour).
+TEST(ShowStreams, ATransparentCameraTextureBlendsWithTheBackground) {
+  const runtime::Color3 blue{0.0f, 0.0f, 1.0f};
+  auto prepare = [&](Harness& h, bool transparent) {
+    ASSERT_TRUE(installLossShow(h, ""));  // the unplug comes at 0.4 s: these runs end before it
+    h.show().global().background = blue;
+    if (transparent) {
+      h.show().editGlobalStyle([](runtime::PartStyle& s) {
+        s.front.transparencyMethod = runtime::TransparencyMethod::kBlended;
+        s.front.transparencyBlend = runtime::TransparencyBlend::kConstantBackground;
+        s.front.transparency = 0.45f;
+      });
+    }
+  };
+  Harness opaque("transparency-off");
+  OPEN_OR_SKIP(opaque);
+  prepare(opaque, false);
+  Harness glass("transparency-on");
+  OPEN_OR_SKIP(glass);
+  prepare(glass, true);
+  opaque.run(6);
+  glass.run(6);
+  const LoadedTexture* camera = glass.texture("camera.png");
+  ASSERT_TRUE(camera && camera->live) << (camera ? camera->stream->describe() : "no camera texture");
+  const Image& a = opaque.lastFrame();
+  const Image& b = glass.lastFrame();
+  ASSERT_EQ(a.pixels.size(), b.pixels.size());
+  std::size_t onSculpture = 0, blended = 0, distinct = 0;
+  std::set<std::uint32_t> colours;
+  for (std::size_t i = 0; i + 3 < a.pixels.size(); i += 4) {
+    const int r = a.pixels[i], g = a.pixels[i + 1], bl = a.pixels[i + 2];
+    if (r < 8 && g < 8 && bl > 247) continue;  // the background, not the sculpture
+    ++onSculpture;
+    const auto expect = [](int opaqueValue, int background) { return 0.55 * opaqueValue + 0.45 * background; };
+    if (std::abs(b.pixels[i] - expect(r, 0)) <= 4 && std::abs(b.pixels[i + 1] - expect(g, 0)) <= 4 &&
+        std::abs(b.pixels[i + 2] - expect(bl, 255)) <= 4) {
+      ++blended;
+    }
+    if (colours.insert(static_cast<std::uint32_t>(b.pixels[i] << 16 | b.pixels[i + 1] << 8 | b.pixels[i + 2])).second) {
+      ++distinct;
+    }
+  }
+  ASSERT_GT(onSculpture, 200u) << "the sculpture covers the view";
+  EXPECT_GE(blended, onSculpture * 98 / 100) << blended << " of " << onSculpture << " pixels blended as specified";
+  EXPECT_GT(distinct, 8u) << "the camera's picture still shows through";
 }
 
 TEST(ShowStreams, MatroskaTracesReplayTheRecordedFramesAtTheirMicrosecond) {
