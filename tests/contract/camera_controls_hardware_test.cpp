@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "devices/v4l2/v4l2_camera.h"
 #include "runtime/clock.h"
 #include "runtime/log.h"
@@ -72,7 +74,7 @@ TEST(V4l2Controls, InputThatExistsOpensAndOneThatDoesNotSaysWhich) {
   if (nodes.empty()) GTEST_SKIP() << test::needsVlab("BASALT_VLAB_V4L2_WEBCAM or BASALT_VLAB_V4L2_HDMI (vivid)");
   SystemClock clock;
   for (const auto& [variable, node] : nodes) {
-    SCOPED_TRACE(variable + " " + node);
+    SCOPED_TRACE(fmt::format("{} {}", variable, node));
     auto d = describeV4l2Device(node);
     ASSERT_TRUE(d) << d.error().describe();
     ASSERT_FALSE(d->inputs.empty());
