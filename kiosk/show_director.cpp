@@ -2,7 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <thread>
 
 #include <fmt/format.h>
 #include <fmt/std.h>
@@ -23,7 +29,63 @@ constexpr Nanos kMaxRetry = std::chrono::seconds(30);
 
 ShowDirector::ShowDirector(DirectorContext context) : context_(context) { context_.board.setShowClock(context_.clock); }
 
+/// A dial box's open on the device thread; `result` is written before `done`.
+struct PendingOpen {
+  std::atomic<bool> done{false};
+  Result<void> result;
+};
+
+/// Opens dial boxes one after another on a thread of its own, so that a device enumeration or a
+/// serial port's reset wait never holds up a frame; it also closes the boxes of a replaced show
+/// whose open was still running. Tasks run in the order given; the thread finishes them all
+/// before it ends.
+class ShowDirector::DeviceThread {
+ public:
+  DeviceThread() : thread_([this] { run(); }) {}
+  ~DeviceThread() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();
+  }
+  DeviceThread(const DeviceThread&) = delete;
+  DeviceThread& operator=(const DeviceThread&) = delete;
+
+  void post(std::function<void()> task) {
+    {
+      std::lock_guard lock(mutex_);
+      tasks_.push_back(std::move(task));
+    }
+    wake_.notify_one();
+  }
+
+ private:
+  void run() {
+    for (;;) {
+      std::function<void()> task;
+      {
+        std::unique_lock lock(mutex_);
+        wake_.wait(lock, [this] { return stopping_ || !tasks_.empty(); });
+        if (tasks_.empty()) return;
+        task = std::move(tasks_.front());
+        tasks_.pop_front();
+      }
+      task();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> tasks_;  // guarded by mutex_
+  bool stopping_ = false;                    // guarded by mutex_
+  std::thread thread_;                       // last: starts once the rest is built
+};
+
 ShowDirector::~ShowDirector() {
+  if (udev_) udev_->stop();
+  deviceThread_.reset();  // an open still running ends first; then every box is the frame loop's
   if (loader_.joinable()) loader_.join();
   if (textureLoader_.joinable()) textureLoader_.join();
   if (show_) {
@@ -50,7 +112,7 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   // The old show's devices stop; their queued events are stale.
   if (show_) {
     for (DeviceSlot& slot : show_->devices) {
-      if (slot.dialBox) slot.dialBox->close();
+      if (slot.dialBox && !slot.opening) slot.dialBox->close();  // an opening one: see below
     }
     for (const LoadedTexture& t : show_->textures) context_.renderer.textures().remove(t.name);
   }
@@ -87,7 +149,39 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   applyProgramme(now);
   publishDevices();
   publishStreams();
+  if (old && deviceThread_) {
+    // Boxes whose open still runs belong to the device thread: it closes and drops them after.
+    auto orphans = std::make_shared<std::vector<std::unique_ptr<devices::DialBox>>>();
+    for (DeviceSlot& slot : old->devices) {
+      if (slot.opening && slot.dialBox) orphans->push_back(std::move(slot.dialBox));
+    }
+    if (!orphans->empty()) {
+      deviceThread_->post([orphans] {
+        for (auto& box : *orphans) box->close();
+        orphans->clear();
+      });
+    }
+  }
+  watchHotplug();
   old.reset();  // after the new show is on: its players and devices go now
+}
+
+void ShowDirector::watchHotplug() {
+  if (udev_ || context_.clock.isManual()) return;
+  const bool hardware = std::ranges::any_of(show_->devices, [](const DeviceSlot& slot) {
+    return slot.dialBox && (slot.spec.backend == DeviceBackend::kHid || slot.spec.backend == DeviceBackend::kSerial);
+  });
+  if (!hardware) return;
+  auto monitor = devices::UdevMonitor::create({"hidraw", "usb", "tty"});
+  if (!monitor) {
+    log::info(kLogDirector, "no udev hotplug ({}): absent dial boxes are tried again on their back-off only",
+              monitor.error().describe());
+    return;
+  }
+  udev_ = std::move(*monitor);
+  udev_->start([this](const devices::HotplugEvent& e) {
+    if (e.action == devices::HotplugEvent::Action::kAdded) noteHotplug();
+  });
 }
 
 void ShowDirector::loadTexturesInBackground() {
@@ -281,24 +375,44 @@ void ShowDirector::handleControls(const FrameContext& frame) {
 void ShowDirector::serviceDevices(Nanos now) {
   bool changed = false;
   const WallTime wall = context_.clock.wallNow();
+  if (hotplug_.exchange(false, std::memory_order_acq_rel)) {
+    // Something was plugged in: whatever is absent may be it.
+    for (DeviceSlot& slot : show_->devices) {
+      if (slot.dialBox && !slot.opening && slot.dialBox->state() != devices::DeviceState::kLive) {
+        slot.nextAttempt = now;
+        slot.backoff = std::chrono::seconds(1);
+      }
+    }
+  }
   for (std::size_t i = 0; i < show_->devices.size(); ++i) {
     DeviceSlot& slot = show_->devices[i];
     if (!slot.dialBox) continue;
     devices::DialBox& box = *slot.dialBox;
-    if (box.state() != devices::DeviceState::kLive && now >= slot.nextAttempt) {
-      auto opened = box.open(static_cast<DeviceId>(i + 1), context_.events);
-      if (opened) {
-        slot.backoff = std::chrono::seconds(1);
-        slot.message.clear();
+    if (slot.opening) {
+      // The device thread owns the box until its open is done.
+      if (!slot.opening->done.load(std::memory_order_acquire)) continue;
+      const Result<void> opened = std::move(slot.opening->result);
+      slot.opening.reset();
+      noteOpen(slot, opened, now, changed);
+    } else if (box.state() != devices::DeviceState::kLive && now >= slot.nextAttempt) {
+      const auto id = static_cast<DeviceId>(i + 1);
+      if (context_.clock.isManual()) {
+        // Under a ManualClock a run repeats frame by frame: the open happens here.
+        const Result<void> opened = box.open(id, context_.events);
+        noteOpen(slot, opened, now, changed);
       } else {
-        if (slot.message != opened.error().message()) {
-          log::warn(kLogDirector, "device '{}' ({}): {}; retrying every {} s at most", slot.spec.name,
-                    deviceBackendName(slot.spec.backend), opened.error().describe(), toSeconds(kMaxRetry));
-        }
-        if (slot.message != opened.error().message()) changed = true;  // the status shows the new reason
-        slot.message = opened.error().message();
-        slot.nextAttempt = now + slot.backoff;
-        slot.backoff = std::min(slot.backoff * 2, kMaxRetry);
+        // Enumerating devices and opening one can take long (a serial port's reset wait):
+        // never on the frame loop's thread.
+        if (!deviceThread_) deviceThread_ = std::make_unique<DeviceThread>();
+        auto pending = std::make_shared<PendingOpen>();
+        slot.opening = pending;
+        BoundedQueue<Event>* events = &context_.events;
+        devices::DialBox* target = &box;
+        deviceThread_->post([target, id, events, pending] {
+          pending->result = target->open(id, *events);
+          pending->done.store(true, std::memory_order_release);
+        });
+        continue;
       }
     }
     box.service(now);
@@ -318,6 +432,22 @@ void ShowDirector::serviceDevices(Nanos now) {
     }
   }
   if (changed) publishDevices();
+}
+
+void ShowDirector::noteOpen(DeviceSlot& slot, const Result<void>& opened, Nanos now, bool& changed) {
+  if (opened) {
+    slot.backoff = std::chrono::seconds(1);
+    slot.message.clear();
+    return;
+  }
+  if (slot.message != opened.error().message()) {
+    log::warn(kLogDirector, "device '{}' ({}): {}; retrying every {} s at most", slot.spec.name,
+              deviceBackendName(slot.spec.backend), opened.error().describe(), toSeconds(kMaxRetry));
+    changed = true;  // the status shows the new reason
+  }
+  slot.message = opened.error().message();
+  slot.nextAttempt = now + slot.backoff;
+  slot.backoff = std::min(slot.backoff * 2, kMaxRetry);
 }
 
 void ShowDirector::applyInput(Nanos until) {

@@ -7,6 +7,7 @@
 /// decide what plays and switches items, display power and textures accordingly, feeds the
 /// playing item its frame, and saves where the show is.
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -16,6 +17,7 @@
 #include <thread>
 
 #include "devices/evdev/evdev_input.h"
+#include "devices/udev/udev_monitor.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/kiosk_policy.h"
 #include "kiosk/show_loader.h"
@@ -61,6 +63,9 @@ class ShowDirector final : public FrameParticipant {
 
   /// \brief Installs the first show at `now`, resuming at `resume` when it still fits.
   void install(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume);
+  /// \brief Says that a device came (udev): dial boxes that are not live are tried again at
+  /// the next frame instead of after their back-off. Any thread.
+  void noteHotplug() { hotplug_.store(true, std::memory_order_release); }
   /// \brief Re-reads the manifest on a loader thread; the current show plays on until the new
   /// one is ready, and stays when the new one has errors.
   void requestReload();
@@ -84,6 +89,10 @@ class ShowDirector final : public FrameParticipant {
   [[nodiscard]] std::int64_t lastReloadFrame() const { return lastReloadFrame_; }
 
  private:
+  /// Opens dial boxes off the frame loop's thread (system clock only).
+  class DeviceThread;
+  void noteOpen(DeviceSlot& slot, const Result<void>& opened, Nanos now, bool& changed);
+  void watchHotplug();
   void takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume);
   void pollReload(const FrameContext& frame);
   void loadTexturesInBackground();
@@ -111,6 +120,9 @@ class ShowDirector final : public FrameParticipant {
   DisplayViews* views_ = nullptr;
   devices::EvdevInput* keyboardsAndMice_ = nullptr;
   std::unique_ptr<LoadedShow> show_;
+  std::unique_ptr<DeviceThread> deviceThread_;  // dial boxes open there on the system clock
+  std::unique_ptr<devices::UdevMonitor> udev_;  // a device came: retry the absent at once
+  std::atomic<bool> hotplug_{false};
   std::unique_ptr<KioskPolicy> policy_;
   std::shared_ptr<const Schedule> scheduleForStatus_;
   ItemPlayer* player_ = nullptr;  // the playing item's player, owned by show_

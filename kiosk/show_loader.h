@@ -60,6 +60,9 @@ using DialBoxFactory =
 /// built in.
 void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory);
 
+/// \brief An open of a dial box running on the director's device thread (system clock).
+struct PendingOpen;
+
 /// \brief One device of a show, with what its inputs do.
 struct DeviceSlot {
   DeviceSpec spec;
@@ -73,6 +76,8 @@ struct DeviceSlot {
   WallTime since{};
   Nanos nextAttempt{0};
   Nanos backoff{std::chrono::seconds(1)};
+  /// An open running on the director's device thread: until it is done, that thread owns the box.
+  std::shared_ptr<PendingOpen> opening;
 };
 
 /// \brief One named texture of a show.

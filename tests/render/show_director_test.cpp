@@ -15,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <fstream>
 #include <thread>
 
@@ -228,6 +229,110 @@ action = "none"
   const StatusSnapshot s = turned.board().snapshot(WallTime{});
   ASSERT_EQ(s.devices.size(), 1u);
   EXPECT_EQ(s.devices[0].state, "live");
+}
+
+/// A dial box whose open waits until the test lets it go (a slow enumeration, a serial port's
+/// reset wait), and says on which thread it ran.
+class GatedDialBox final : public devices::DialBox {
+ public:
+  GatedDialBox() : DialBox(devices::DeviceInfo{"gated knob", "test", "", 0, 0, "", ""}, 1, 0) {}
+  ~GatedDialBox() override { close(); }
+  GatedDialBox(const GatedDialBox&) = delete;
+  GatedDialBox& operator=(const GatedDialBox&) = delete;
+
+  std::atomic<bool> release{false};       // the open may end
+  std::atomic<bool> refuse{false};        // ... with an error
+  std::atomic<int> attempts{0};           // opens begun
+  std::atomic<std::thread::id> openedOn;  // the thread of the last open
+
+ private:
+  Result<void> doOpen() override {
+    openedOn = std::this_thread::get_id();
+    ++attempts;
+    for (int i = 0; i < 1000 && !release.load(); ++i) std::this_thread::sleep_for(10ms);
+    if (refuse.load()) return fail(Errc::kNotFound, "the gated knob is not there");
+    return {};
+  }
+  void doClose() override {}
+};
+
+// On the system clock a dial box opens on the director's device thread: a frame never waits for
+// a device enumeration or a serial port (the open below takes as long as the test wants), and a
+// device plugged in (udev) is tried at once instead of after its back-off.
+// Example failures: the frame loop stuck in open(); a box used while its open still runs; a
+// replug noticed only 30 s later.
+TEST(ShowDirector, DialBoxesOpenOffTheFrameLoopAndAHotplugRetriesAtOnce) {
+  std::string why;
+  auto output = render::createHeadlessOutput({32, 32});
+  if (!output) GTEST_SKIP() << "no headless EGL here: " << output.error().describe();
+  auto renderer = render::Renderer::create();
+  ASSERT_TRUE(renderer);
+  const SystemClock clock;
+  auto loop = runtime::EventLoop::create(clock);
+  ASSERT_TRUE(loop);
+  const auto dir = test::scratchDir("director-gated");
+  std::ofstream(dir / "show.toml") << R"(
+[show]
+entry = "default"
+[devices.knob]
+kind = "dial_box"
+backend = "synthetic"
+)";
+  Diagnostics d;
+  auto m = readManifest(dir / "show.toml", d);
+  ASSERT_TRUE(m) << d.format();
+  auto loaded = loadShow(std::move(*m), clock);
+  ASSERT_TRUE(loaded) << loaded.error().describe();
+  ASSERT_EQ((*loaded)->devices.size(), 1u);
+  auto gated = std::make_unique<GatedDialBox>();
+  GatedDialBox& knob = *gated;
+  (*loaded)->devices[0].dialBox = std::move(gated);
+  runtime::Show show;
+  StatusBoard board(clock.wallNow(), 30);
+  BoundedQueue<Event> events(64);
+  {
+    ShowDirector director(
+        DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, nullptr, 30});
+    const Nanos t0 = clock.now();
+    director.install(std::move(*loaded), t0, std::nullopt);
+    // The show's time stands still at t0: a back-off never ends by itself.
+    auto frame = [&](std::int64_t n) { return director.beforeDraw(FrameContext{n, t0, false}); };
+    auto knobState = [&] { return board.snapshot(clock.wallNow()).devices.at(0).state; };
+
+    // The first frame starts the open and goes on; so do the next ones while it runs.
+    ASSERT_TRUE(frame(0));
+    for (int i = 0; i < 500 && knob.attempts.load() == 0; ++i) std::this_thread::sleep_for(10ms);
+    ASSERT_EQ(knob.attempts.load(), 1) << "the open began";
+    EXPECT_NE(knob.openedOn.load(), std::this_thread::get_id()) << "opened on the frame loop's thread";
+    for (std::int64_t n = 1; n <= 5; ++n) ASSERT_TRUE(frame(n)) << "frames go on while the open runs";
+    EXPECT_FALSE(knob.release.load());
+    EXPECT_NE(knobState(), "live");
+    knob.release = true;
+    for (int i = 0; i < 500 && knobState() != "live"; ++i) {
+      ASSERT_TRUE(frame(6));
+      std::this_thread::sleep_for(10ms);
+    }
+    EXPECT_EQ(knobState(), "live") << board.snapshot(clock.wallNow()).devices.at(0).message;
+
+    // Unplugged: lost, and opening it again fails. With the show's time standing still its
+    // back-off never ends, but a hotplug notice has it tried again at once.
+    knob.refuse = true;
+    knob.close();
+    auto frames = [&](int count) {
+      for (int i = 0; i < count; ++i) {
+        ASSERT_TRUE(frame(7));
+        std::this_thread::sleep_for(10ms);
+      }
+    };
+    frames(30);
+    const int settled = knob.attempts.load();
+    ASSERT_GE(settled, 2) << "a lost box is opened again";
+    frames(30);
+    EXPECT_EQ(knob.attempts.load(), settled) << "no retry before the back-off ends";
+    director.noteHotplug();
+    for (int i = 0; i < 500 && knob.attempts.load() == settled; ++i) frames(1);
+    EXPECT_EQ(knob.attempts.load(), settled + 1) << "a hotplug notice retries at once";
+  }  // the director ends with an open running: it waits for it, never uses the box meanwhile
 }
 
 /// How far apart two shows' placements are (Frobenius norm of the difference): unchanged by the
