@@ -162,6 +162,20 @@ bool MjpegDecoder::push(const FrameRef& jpeg) {
     impl_->dropped.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
+  // A JPEG cut short (a USB transfer that lost its end) has no end-of-image marker; jpegdec's
+  // parser would wait for one forever and the frame would be neither shown nor counted. Cameras
+  // may pad a frame after the marker, so look back over the padding.
+  {
+    const std::uint8_t* bytes = jpeg->planes[0].data;
+    std::size_t end = jpeg->bytesUsed;
+    const std::size_t floor = end > 4096 ? end - 4096 : 0;
+    while (end > floor && bytes[end - 1] == 0) --end;
+    if (end < 4 || bytes[end - 2] != 0xFF || bytes[end - 1] != 0xD9) {
+      impl_->corrupt.fetch_add(1, std::memory_order_relaxed);
+      impl_->decodedCv.notify_all();
+      return false;
+    }
+  }
   // The buffer wraps the camera's memory and holds the frame until the decoder is done.
   auto* hold = new FrameRef(jpeg);
   GstBuffer* buffer =

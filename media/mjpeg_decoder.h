@@ -35,7 +35,8 @@ class MjpegDecoder final : public FrameSource {
 
   /// \brief Queues one JPEG (a Frame of format kMjpeg with bytesUsed set) for decoding. The
   /// frame is held, not copied, until the decoder is done with it. False when the decoder is
-  /// behind (the frame is dropped and counted) or the frame is not MJPEG.
+  /// behind (the frame is dropped and counted), the frame is not MJPEG, or the JPEG was cut short
+  /// (no end-of-image marker: counted as corrupt).
   bool push(const FrameRef& jpeg);
   /// \brief The newest decoded frame due at `showTime`.
   FrameRef frameAt(Nanos showTime) override;

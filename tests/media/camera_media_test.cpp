@@ -72,8 +72,12 @@ TEST(MjpegDecoder, DamagedJpegIsDroppedAndTheStreamGoesOn) {
   std::vector<std::uint8_t> garbage = numberedJpeg(3);
   garbage.resize(garbage.size() / 3);  // a USB transfer cut short
   for (std::size_t i = 200; i < garbage.size(); i += 7) garbage[i] = 0xA5;
-  EXPECT_TRUE((*decoder)->push(mjpegFrame(*pool, garbage, 0, 1)));
-  ASSERT_TRUE((*decoder)->push(mjpegFrame(*pool, numberedJpeg(42), 40, 2)));
+  EXPECT_FALSE((*decoder)->push(mjpegFrame(*pool, garbage, 0, 1))) << "no end-of-image marker";
+  EXPECT_EQ((*decoder)->corrupt(), 1u) << "counted at once, not left waiting in the parser";
+  // A whole JPEG padded with zeros after its end marker, as cameras send them, is fine.
+  std::vector<std::uint8_t> padded = numberedJpeg(42);
+  padded.resize(padded.size() + 300, 0);
+  ASSERT_TRUE((*decoder)->push(mjpegFrame(*pool, padded, 40, 2)));
   ASSERT_TRUE((*decoder)->waitForDecoded(1, std::chrono::seconds(10)));
   FrameRef f = (*decoder)->frameAt(std::chrono::milliseconds(40));
   ASSERT_TRUE(f);
