@@ -263,6 +263,7 @@ struct MoviePlayer::Impl {
   std::atomic<std::uint64_t> decoded{0};
   std::atomic<std::uint64_t> shown{0};
   std::atomic<std::uint64_t> loops{0};
+  std::atomic<std::int64_t> passNs{0};  // one pass of a looping clip on the timeline (0: not looped yet)
   std::atomic<std::uint64_t> stalls{0};
 
   // Decoder thread only:
@@ -465,6 +466,15 @@ Result<void> MoviePlayer::Impl::finishOpen(Clip& clip, std::chrono::milliseconds
     mi.hasAudio = clip.hasAudio;
     mi.audioOutputMissing = clip.audioUnavailable;
   }
+  if (clip.start.count() < 0) {
+    // Frame 0's timestamp from the preroll sample (pull_sample hands the same sample out again),
+    // not from whichever buffer deliver() sees first: after an accurate seek that is the target
+    // frame, clipped a quarter frame late, which would shift every later frame of the clip and
+    // make one node's loop a fraction of a frame shorter than another's.
+    SamplePtr preroll(gst_app_sink_try_pull_preroll(reinterpret_cast<GstAppSink*>(clip.sink), 0));
+    GstBuffer* first = preroll ? gst_sample_get_buffer(preroll.get()) : nullptr;
+    if (first && GST_BUFFER_PTS_IS_VALID(first)) clip.start = fromGstTime(GST_BUFFER_PTS(first));
+  }
   clip.prerolled = true;
   log::info(kLogMedia, "{}: {} {}x{} {:.3f} fps {} ({}), {} frames{}; upload path: {} planes + shader", clip.name,
             clip.path.filename(), mi.width, mi.height, mi.fps, mi.codec, pixelFormatName(mi.format), mi.frameCount,
@@ -610,6 +620,7 @@ void MoviePlayer::Impl::endOfClip() {
     gst_element_set_state(clip.pipeline.get(), GST_STATE_READY);
     gst_element_set_state(clip.pipeline.get(), GST_STATE_PLAYING);
   }
+  passNs.store((nextBase - base).count(), std::memory_order_relaxed);
   base = nextBase;
   lastIndex = -1;
   dropBelow = 0;
@@ -861,6 +872,7 @@ Result<void> MoviePlayer::loadPlaylist(const std::vector<std::filesystem::path>&
   speed_ = 1;
   awaitFirst_ = true;
   needShowAnchor_ = false;
+  seekDueAt_.reset();
   pendingIndex_ = 0;
   shownIndex_ = -1;
   shownClip_ = 0;
@@ -938,7 +950,8 @@ std::int64_t MoviePlayer::logicalIndex() const {
   return awaitFirst_ ? pendingIndex_ : std::max<std::int64_t>(0, shownIndex_);
 }
 
-void MoviePlayer::requestSeek(std::int64_t index) {
+void MoviePlayer::requestSeek(std::int64_t index, std::optional<Nanos> timeline) {
+  seekDueAt_.reset();
   const std::int64_t count = frameCount();
   if (count > 0) index = std::min(index, count - 1);
   index = std::max<std::int64_t>(0, index);
@@ -947,7 +960,7 @@ void MoviePlayer::requestSeek(std::int64_t index) {
   awaitFirst_ = true;
   pendingIndex_ = index;
   // The target lands one frame after the shown one on the timeline, so that pts only grow.
-  const Nanos base = shownIndex_ >= 0 ? shownPts_ + frameDuration() : anchorPts_;
+  const Nanos base = timeline ? *timeline : shownIndex_ >= 0 ? shownPts_ + frameDuration() : anchorPts_;
   impl_->post({Impl::Command::Kind::kSeek, generation_, {}, index, base, false});
 }
 
@@ -1030,6 +1043,13 @@ void MoviePlayer::setRepeat(bool on) {
 
 void MoviePlayer::seekFrame(std::int64_t frame) { requestSeek(frame); }
 
+void MoviePlayer::seekFrameDueAt(std::int64_t frame, Nanos due, Nanos timeline) {
+  requestSeek(frame, timeline);
+  seekDueAt_ = due;
+}
+
+Nanos MoviePlayer::passDuration() const { return Nanos{impl_->passNs.load(std::memory_order_relaxed)}; }
+
 void MoviePlayer::seekTime(Nanos time) {
   const Nanos dur = frameDuration();
   requestSeek(time.count() <= 0 ? 0 : time / dur);
@@ -1070,7 +1090,8 @@ FrameRef MoviePlayer::frameAt(Nanos showTime) {
     if (!f) return {};
     awaitFirst_ = false;
     anchorPts_ = f->pts;
-    anchorShow_ = showTime;
+    anchorShow_ = seekDueAt_ ? *seekDueAt_ : showTime;
+    seekDueAt_.reset();
     needShowAnchor_ = false;
   } else {
     f = impl_->queue.takeDue(targetTime(showTime));

@@ -122,6 +122,15 @@ class MoviePlayer final : public FrameSource {
   void setRepeat(bool on);
   void seekFrame(std::int64_t frame);
   void seekTime(Nanos time);
+  /// \brief Seeks to `frame`, placing it at `timeline` on the player's timeline (the frames
+  /// after it follow by their timestamps), and anchors the timeline so that it is due at show
+  /// time `due` (which may have passed: later frames then catch up) rather than when the seek
+  /// lands. Frame-locked nodes start a movie this way on the leader's timeline, so that every
+  /// later frame (and loop) falls where the leader's does.
+  void seekFrameDueAt(std::int64_t frame, Nanos due, Nanos timeline);
+  /// \brief One pass of a looping clip on the timeline (its last frame's timestamp plus a frame
+  /// duration), known once it has looped; 0 before.
+  [[nodiscard]] Nanos passDuration() const;
 
   [[nodiscard]] bool repeat() const { return repeat_; }
   [[nodiscard]] Transport transport() const { return transport_; }
@@ -159,7 +168,7 @@ class MoviePlayer final : public FrameSource {
  private:
   struct Impl;
   explicit MoviePlayer(std::unique_ptr<Impl> impl);
-  void requestSeek(std::int64_t index);
+  void requestSeek(std::int64_t index, std::optional<Nanos> timeline = std::nullopt);
   [[nodiscard]] Nanos targetTime(Nanos showTime) const;
   [[nodiscard]] Nanos frameDuration() const;
   [[nodiscard]] std::int64_t logicalIndex() const;
@@ -183,7 +192,8 @@ class MoviePlayer final : public FrameSource {
   Nanos shownPts_{0};
   std::uint64_t generation_ = 0;  // bumped by every seek and load
   std::uint64_t shownGeneration_ = 0;
-  FrameRef carry_;  // a due frame waitForFrameDue() took out of a full queue
+  FrameRef carry_;                  // a due frame waitForFrameDue() took out of a full queue
+  std::optional<Nanos> seekDueAt_;  // seekFrameDueAt(): the show time the pending seek's frame is due
 };
 
 }  // namespace basalt::media
