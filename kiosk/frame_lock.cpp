@@ -96,6 +96,9 @@ struct FrameLock::Impl {
   runtime::Show& show;
   const LockClockProbe* probe = nullptr;
   std::function<void(const FrameLockFigures&)> publish;
+  LockedDirector* director = nullptr;
+  std::optional<LockedProgramme> lastProgramme;  // the programme last sent (leader) or followed (follower)
+  Nanos lostAt{-1};                              // wall time the leader was reported lost
   Nanos lastPublished{-1};
   bool publishNow = false;
   SystemClock ownClock;
@@ -192,7 +195,27 @@ struct FrameLock::Impl {
     m.showTimeNs = frame.time.count();
     m.sentNs = shared->now().count();
     m.state = captureLockedState(show);
+    if (director) {
+      m.programme = director->lockedProgramme();
+      m.programme.present = true;
+      noteProgramme(m.frame, m.programme, "sends");
+    }
     send(pub.get(), encode(m, buffer));
+  }
+
+  /// Counts and logs a change of programme (item, mode, display, start or media start).
+  void noteProgramme(std::int64_t frame, const LockedProgramme& p, std::string_view verb) {
+    if (lastProgramme && *lastProgramme == p) return;
+    const bool first = !lastProgramme;
+    lastProgramme = p;
+    if (first) return;
+    ++figures.programmeChanges;
+    log::info(kLogLock, "frame {}: {} the programme: {} item {} '{}' since show time {:.3f} s (media from {:.3f} s)",
+              frame, verb,
+              p.mode == 0   ? "closed"
+              : p.mode == 1 ? "attract"
+                            : "active",
+              p.index + 1, p.itemName(), toSeconds(Nanos{p.itemStartNs}), toSeconds(Nanos{p.mediaStartNs}));
   }
 
   void barrier(std::int64_t frame) {
@@ -284,11 +307,17 @@ struct FrameLock::Impl {
     if (!figures.leaderPresent) {
       if (figures.leaderLost > 0) {
         // A restarted leader counts from its own start: take its frames from here on.
-        log::info(kLogLock, "the leader is back");
+        log::info(kLogLock, "the leader is back after {:.1f} s; following its frames again",
+                  toSeconds(wall.now() - lostAt));
+        ++figures.leaderReturned;
         current = -1;
         newestPresented = -1;
+        publishNow = true;
       }
       figures.leaderPresent = true;
+      figures.holding = false;
+      figures.holdingSeconds = 0;
+      figures.heldFrame = -1;
     }
   }
 
@@ -303,12 +332,16 @@ struct FrameLock::Impl {
     }
     if (figures.leaderPresent && now - lastHeard > std::chrono::milliseconds(spec.leaderTimeoutMs)) {
       figures.leaderPresent = false;
+      figures.holding = true;
+      figures.heldFrame = current;
+      lostAt = now;
       ++figures.leaderLost;
       joined = false;     // say hello again, so that a restarted leader counts this follower
       publishNow = true;  // the status page says so while the picture holds
       log::warn(kLogLock, "the leader at {} is lost: nothing for {} ms; holding frame {} until it is back", spec.leader,
                 spec.leaderTimeoutMs, current);
     }
+    if (figures.holding) figures.holdingSeconds = toSeconds(now - lostAt);
     // Until the first frame, say hello every 100 ms: the leader counts who is here before it
     // starts, and knows our SUB socket is connected once we heard its beacon.
     if (!joined && figures.leaderPresent &&
@@ -330,6 +363,12 @@ struct FrameLock::Impl {
         if (current >= 0 && f.frame > current + 1) figures.skipped += f.frame - current - 1;
         current = f.frame;
         joined = true;
+        // The leader's programme before any participant runs: the director plays the item the
+        // leader plays in this very frame.
+        if (director && f.programme.present) {
+          if (director->followProgramme(f.programme, Nanos{f.showTimeNs}))
+            noteProgramme(f.frame, f.programme, "follows");
+        }
         return GatedFrame{f.frame, Nanos{f.showTimeNs}, false};
       }
       const Nanos left = deadline - wall.now();
@@ -436,6 +475,8 @@ void FrameLock::setPublisher(std::function<void(const FrameLockFigures&)> publis
   impl_->publish = std::move(publish);
 }
 
+void FrameLock::setDirector(LockedDirector* director) { impl_->director = director; }
+
 void FrameLock::afterPresent(const FrameContext& frame) {
   (void)frame;
   Impl& d = *impl_;
@@ -502,9 +543,16 @@ bool FrameLock::wantsStop() const { return !impl_->isLeader() && impl_->byeSeen 
 Result<std::optional<GatedFrame>> FrameLock::nextFrame(runtime::EventLoop& loop, Nanos patience) {
   if (impl_->isLeader()) return fail(Errc::kInternal, "frame lock: the leader paces itself; it has no gate");
   auto next = impl_->nextFrame(loop, patience);
-  if (impl_->publishNow && impl_->publish) {
-    impl_->publishNow = false;
-    impl_->publish(figures());
+  Impl& d = *impl_;
+  // While the picture holds no frame is presented (afterPresent publishes then): the status
+  // page still hears about the hold once a second, and at once when it starts or ends.
+  const Nanos now = d.ownClock.now();
+  const bool due =
+      d.figures.holding && (d.lastPublished.count() < 0 || now - d.lastPublished >= std::chrono::seconds(1));
+  if ((d.publishNow || due) && d.publish) {
+    d.publishNow = false;
+    d.lastPublished = now;
+    d.publish(figures());
   }
   return next;
 }
@@ -526,16 +574,17 @@ std::string FrameLock::describe() const {
     return fmt::format(
         "frame lock: leader '{}': {} followers in the barrier ({} known), {} frames presented without every answer, "
         "{} dropped, {} rejoined, {} late answers, barrier wait median {:.3f} ms max {:.3f} ms, largest follower "
-        "clock offset {} us, {} malformed messages",
+        "clock offset {} us, {} malformed messages, {} programme changes sent",
         f.node, f.followers, f.followersKnown, f.barrierTimeouts, f.followersDropped, f.followersRejoined,
-        f.lateAnswers, f.barrierWaitP50Ms, f.barrierWaitMaxMs, f.maxClockOffsetUs, f.malformed);
+        f.lateAnswers, f.barrierWaitP50Ms, f.barrierWaitMaxMs, f.maxClockOffsetUs, f.malformed, f.programmeChanges);
   }
   return fmt::format(
       "frame lock: follower '{}': drew {} frames, {}..{}, checksum {:016x}, {} skipped, {} presented without the "
       "leader's word, skew at most {} frames, leader lost {} times, clock offset {} us (largest {} us), delay median "
-      "{:.3f} ms max {:.3f} ms, {} malformed messages",
+      "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times, {} programme changes followed",
       f.node, f.framesDrawn, f.firstFrame, f.lastFrame, f.frameChecksum, f.skipped, f.presentsMissed, f.maxSkewFrames,
-      f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs, f.malformed);
+      f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs, f.malformed, f.leaderReturned,
+      f.programmeChanges);
 }
 
 }  // namespace basalt::kiosk

@@ -39,6 +39,19 @@ class LockClockProbe {
   [[nodiscard]] virtual Nanos offset() const = 0;
 };
 
+/// \brief The kiosk's director as the lock sees it (kiosk/show_director.h): the leader sends its
+/// programme with every frame; a follower takes the leader's before each frame is drawn, so that
+/// an item switched on the leader is switched on every node in the same frame.
+class LockedDirector {
+ public:
+  virtual ~LockedDirector() = default;
+  /// \brief Leader: what plays now (called in the lock's beforeDraw, after the director's).
+  [[nodiscard]] virtual LockedProgramme lockedProgramme() const = 0;
+  /// \brief Follower: plays the leader's programme from the frame at `showTime` on (called
+  /// before any participant's beforeDraw). True when what plays changed.
+  virtual bool followProgramme(const LockedProgramme& programme, Nanos showTime) = 0;
+};
+
 /// \brief One node of a frame-locked group: a FrameParticipant on both roles (add it last, so
 /// that it sees the frame's final state), and the FrameGate of a follower's loop.
 ///
@@ -68,6 +81,9 @@ class FrameLock final : public FrameParticipant, public FrameGate {
   /// \brief Called on the frame loop's thread with the figures after the first frame and then
   /// about once a second (the kiosk hands them to the StatusBoard).
   void setPublisher(std::function<void(const FrameLockFigures&)> publish);
+  /// \brief The director whose programme the leader sends and a follower follows; borrowed, null
+  /// for none (a script run: followers then keep their own).
+  void setDirector(LockedDirector* director);
 
   Result<void> beforeDraw(const FrameContext& frame) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;

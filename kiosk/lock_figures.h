@@ -32,7 +32,13 @@ struct FrameLockFigures {
   std::int64_t maxSkewFrames = 0;   ///< newest frame the leader presented minus this node's, largest
   std::int64_t leaderLost = 0;      ///< times the leader went quiet
   bool leaderPresent = false;
-  std::int64_t clockOffsetUs = 0;  ///< shared clock minus own clock at the last frame
+  bool holding = false;                    ///< the leader is lost and this node holds its last picture
+  double holdingSeconds = 0;               ///< how long it has held it (0 when not holding)
+  std::int64_t leaderReturned = 0;         ///< times a lost leader came back
+  std::int64_t heldFrame = -1;             ///< the frame held while holding
+  std::int64_t programmeChanges = 0;       ///< times the programme changed (leader: sent; follower: followed)
+  std::uint64_t watchdogPingsHolding = 0;  ///< systemd watchdog pings sent while holding (run_command fills it)
+  std::int64_t clockOffsetUs = 0;          ///< shared clock minus own clock at the last frame
   std::int64_t maxClockOffsetUsSeen = 0;
   std::uint64_t frameChecksum = 0;  ///< FNV-1a over the frame numbers drawn, in order
   // Both.

@@ -16,7 +16,7 @@ static_assert(std::endian::native == std::endian::little, "the frame-lock encodi
 namespace {
 
 constexpr std::array<char, 4> kMagic{'B', 'L', 'C', 'K'};
-constexpr std::uint8_t kVersion = 1;
+constexpr std::uint8_t kVersion = 2;
 
 class Writer {
  public:
@@ -178,6 +178,16 @@ std::string ReadyMessage::nodeName() const {
   return {node.begin(), end};
 }
 
+std::string LockedProgramme::itemName() const {
+  const auto end = std::find(item.begin(), item.end(), '\0');
+  return {item.begin(), end};
+}
+
+void LockedProgramme::setItemName(std::string_view name) {
+  item.fill('\0');
+  std::copy_n(name.begin(), std::min(name.size(), item.size()), item.begin());
+}
+
 void ReadyMessage::setNodeName(std::string_view name) {
   node.fill('\0');
   std::copy_n(name.begin(), std::min(name.size(), node.size()), node.begin());
@@ -206,6 +216,18 @@ std::size_t encode(const FrameMessage& m, LockBuffer& out) {
   w.put(s.viewerPosition);
   w.put(s.viewerRotation);
   w.put(s.eyeSpacing);
+  const LockedProgramme& p = m.programme;
+  w.put(static_cast<std::uint8_t>((p.present ? 1U : 0U) | (p.hasItem ? 2U : 0U)));
+  w.put(p.mode);
+  w.put(p.display);
+  w.put(std::uint8_t{0});
+  w.put(p.index);
+  w.put(p.itemStartNs);
+  w.put(p.mediaStartNs);
+  w.put(p.reloads);
+  w.put(std::uint32_t{0});
+  w.bytes(p.item.data(), p.item.size());
+  for (const std::int64_t pass : p.moviePassNs) w.put(pass);
   return w.size();
 }
 
@@ -288,6 +310,30 @@ Result<FrameMessage> decodeFrame(std::span<const std::byte> bytes) {
   s.viewerPosition = r.vec3();
   s.viewerRotation = r.vec3();
   s.eyeSpacing = r.get<float>();
+  LockedProgramme& p = m.programme;
+  const auto programmeFlags = r.get<std::uint8_t>();
+  p.mode = r.get<std::uint8_t>();
+  p.display = r.get<std::uint8_t>();
+  const auto reserved = r.get<std::uint8_t>();
+  p.index = r.get<std::uint32_t>();
+  p.itemStartNs = r.get<std::int64_t>();
+  p.mediaStartNs = r.get<std::int64_t>();
+  p.reloads = r.get<std::uint32_t>();
+  const auto reserved2 = r.get<std::uint32_t>();
+  r.bytes(p.item.data(), p.item.size());
+  for (std::int64_t& pass : p.moviePassNs) pass = r.get<std::int64_t>();
+  if (std::any_of(p.moviePassNs.begin(), p.moviePassNs.end(), [](std::int64_t pass) { return pass < 0; })) {
+    return fail(Errc::kParse, "frame-lock message: the 'frame' message's programme has a negative movie pass");
+  }
+  if (programmeFlags > 3 || reserved != 0 || reserved2 != 0) {
+    return fail(Errc::kParse,
+                "frame-lock message: the 'frame' message's programme flags or reserved bytes are unknown");
+  }
+  if (p.mode > 2 || p.display > 2) {
+    return failf(Errc::kParse, "frame-lock message: programme mode {} or display {} is unknown", p.mode, p.display);
+  }
+  p.present = (programmeFlags & 1U) != 0;
+  p.hasItem = (programmeFlags & 2U) != 0;
   if (auto f = finiteOrFail(r, LockMessageKind::kFrame); !f) return std::unexpected(f.error());
   if (m.frame < 0) return failf(Errc::kParse, "frame-lock message: frame number {} is negative", m.frame);
   return m;

@@ -5,10 +5,11 @@
 /// sends each frame, and what the followers answer. Plain encoding and decoding, no sockets:
 /// `kiosk/frame_lock.cpp` carries the bytes over ZeroMQ, and every message is one ZeroMQ frame.
 ///
-/// Layout: every message starts with the 4 bytes "BLCK", a version byte (1), a kind byte and
+/// Layout: every message starts with the 4 bytes "BLCK", a version byte (2), a kind byte and
 /// two bytes of zero, then the kind's fixed fields, little-endian (integers two's complement,
 /// floats IEEE 754). The size of each kind is fixed; a message of another size, another magic or
-/// version, an unknown kind or a non-finite number is rejected with the reason.
+/// version, an unknown kind or a non-finite number is rejected with the reason. Version 2 added
+/// the director's programme (LockedProgramme) to the `frame` message.
 
 #include <array>
 #include <cstddef>
@@ -55,6 +56,28 @@ LockedShowState captureLockedState(const runtime::Show& show);
 /// \brief Puts the leader's state into a follower's Show.
 void applyLockedState(const LockedShowState& state, runtime::Show& show);
 
+/// \brief The leader's programme (thesis §4.5: one director for the group): what its kiosk
+/// policy plays, since when, and when its show's media streams started, so that followers play
+/// the same item from the same point and their movies show the same video frame.
+struct LockedProgramme {
+  bool present = false;           ///< false: the leader has no director (a script run)
+  bool hasItem = false;           ///< an item plays (not black, not off)
+  std::uint8_t mode = 2;          ///< KioskMode: 0 closed, 1 attract, 2 active
+  std::uint8_t display = 0;       ///< DisplayState: 0 on, 1 black, 2 off
+  std::uint32_t index = 0;        ///< the item's place in its list
+  std::int64_t itemStartNs = 0;   ///< show time the item started
+  std::int64_t mediaStartNs = 0;  ///< show time the show's [media] streams started (their frame 0)
+  std::uint32_t reloads = 0;      ///< reloads the leader applied: a follower reloads when it grows
+  std::array<char, 32> item{};    ///< the item's name, NUL-padded (checked against the follower's list)
+  /// One pass of each of the show's first looping movie streams on the leader's timeline (0:
+  /// not looped yet), in the manifest's texture order: where a follower joining late places
+  /// the current loop.
+  std::array<std::int64_t, 4> moviePassNs{};
+  friend bool operator==(const LockedProgramme&, const LockedProgramme&) = default;
+  [[nodiscard]] std::string itemName() const;
+  void setItemName(std::string_view name);
+};
+
 enum class LockMessageKind : std::uint8_t {
   kFrame = 1,    ///< leader -> all: draw frame N with this state
   kPresent = 2,  ///< leader -> all: present frame N now
@@ -68,6 +91,7 @@ struct FrameMessage {
   std::int64_t showTimeNs = 0;  ///< the frame's time on the shared clock
   std::int64_t sentNs = 0;      ///< when the leader sent it, on the shared clock (delay figures)
   LockedShowState state;
+  LockedProgramme programme;
   friend bool operator==(const FrameMessage&, const FrameMessage&) = default;
 };
 
@@ -98,7 +122,10 @@ constexpr std::size_t kLockHeaderBytes = 8;
 /// Three matrices, two rotations, two scales, the motion flags and frame count, the view's
 /// centre and three numbers, the viewer's position and rotation, the eye spacing.
 constexpr std::size_t kLockedStateBytes = 284;
-constexpr std::size_t kFrameMessageBytes = kLockHeaderBytes + 24 + kLockedStateBytes;
+/// Flags, mode, display, a reserved byte, the index, two times, the reload count, four reserved
+/// bytes, the item's name and four movie passes.
+constexpr std::size_t kLockedProgrammeBytes = 96;
+constexpr std::size_t kFrameMessageBytes = kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes;
 constexpr std::size_t kPresentMessageBytes = kLockHeaderBytes + 8;
 constexpr std::size_t kReadyMessageBytes = kLockHeaderBytes + 24 + 32;
 constexpr std::size_t kByeMessageBytes = kLockHeaderBytes + 8;

@@ -126,12 +126,15 @@ std::string healthJson(const StatusSnapshot& s) {
         "\"barrier_timeouts\": {}, \"followers_dropped\": {}, \"followers_rejoined\": {}, \"late_answers\": {}, "
         "\"barrier_wait_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"leader_present\": {}, \"leader_lost\": {}, "
         "\"frames_drawn\": {}, \"last_frame\": {}, \"skipped\": {}, \"presents_missed\": {}, \"skew_frames_max\": {}, "
-        "\"clock_offset_us\": {}, \"delay_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"malformed\": {}}},\n",
+        "\"clock_offset_us\": {}, \"delay_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"malformed\": {}, "
+        "\"holding\": {}, \"holding_seconds\": {:.1f}, \"held_frame\": {}, \"leader_returned\": {}, "
+        "\"watchdog_pings_holding\": {}, \"programme_changes\": {}}},\n",
         jsonString(l->leader ? "leader" : "follower"), jsonString(l->node), l->followers, l->followersKnown,
         l->barrierTimeouts, l->followersDropped, l->followersRejoined, l->lateAnswers, l->barrierWaitP50Ms,
         l->barrierWaitMaxMs, l->leaderPresent ? "true" : "false", l->leaderLost, l->framesDrawn, l->lastFrame,
         l->skipped, l->presentsMissed, l->maxSkewFrames, l->leader ? l->maxClockOffsetUs : l->clockOffsetUs,
-        l->delayP50Ms, l->delayMaxMs, l->malformed);
+        l->delayP50Ms, l->delayMaxMs, l->malformed, l->holding ? "true" : "false", l->holdingSeconds, l->heldFrame,
+        l->leaderReturned, l->watchdogPingsHolding, l->programmeChanges);
   }
   out += "  \"devices\": [";
   for (std::size_t i = 0; i < s.devices.size(); ++i) {
@@ -278,6 +281,9 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
     } else {
       lockMetric("basalt_lock_leader_present", "gauge", "1 while the leader is heard.", l->leaderPresent ? 1 : 0);
       lockMetric("basalt_lock_leader_lost_total", "counter", "Times the leader went quiet.", l->leaderLost);
+      lockMetric("basalt_lock_holding", "gauge", "1 while this follower holds its picture for a lost leader.",
+                 l->holding ? 1 : 0);
+      lockMetric("basalt_lock_leader_returned_total", "counter", "Times a lost leader came back.", l->leaderReturned);
       lockMetric("basalt_lock_frames_skipped_total", "counter", "Leader frames this follower passed over.", l->skipped);
       lockMetric("basalt_lock_presents_missed_total", "counter", "Frames presented without the leader's word.",
                  l->presentsMissed);

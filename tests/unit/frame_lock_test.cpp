@@ -37,6 +37,15 @@ FrameMessage sampleFrame() {
   show.viewer().position = {4, 1.7f, -3};
   show.viewer().rotation = {0, 45, 0};
   m.state = captureLockedState(show);
+  m.programme.present = true;
+  m.programme.hasItem = true;
+  m.programme.mode = 1;
+  m.programme.index = 3;
+  m.programme.itemStartNs = 12'000'000'000;
+  m.programme.mediaStartNs = 250'000'000;
+  m.programme.reloads = 2;
+  m.programme.setItemName("night sky");
+  m.programme.moviePassNs = {3'000'333'333, 0, 0, 0};
   return m;
 }
 
@@ -52,6 +61,7 @@ TEST(LockProtocol, MessagesRoundTrip) {
   auto back = decodeFrame(bytesOf(b, n));
   ASSERT_TRUE(back) << back.error().message();
   EXPECT_EQ(*back, frame);
+  EXPECT_EQ(back->programme.itemName(), "night sky");
 
   runtime::Show follower;
   applyLockedState(back->state, follower);
@@ -91,7 +101,7 @@ TEST(LockProtocol, MalformedMessagesAreRejectedWithTheReason) {
   std::memcpy(longer.data(), b.data(), n);
   auto tooLong = decodeFrame(longer);
   ASSERT_FALSE(tooLong);
-  EXPECT_NE(tooLong.error().message().find("this one has 317"), std::string::npos) << tooLong.error().message();
+  EXPECT_NE(tooLong.error().message().find("this one has 413"), std::string::npos) << tooLong.error().message();
 
   LockBuffer bad = b;
   bad[0] = std::byte{'X'};
@@ -100,10 +110,11 @@ TEST(LockProtocol, MalformedMessagesAreRejectedWithTheReason) {
   EXPECT_NE(magic.error().message().find("magic"), std::string::npos);
 
   bad = b;
-  bad[4] = std::byte{2};
+  bad[4] = std::byte{1};  // a basalt from before the programme was sent
   auto version = decodeFrame(bytesOf(bad, n));
   ASSERT_FALSE(version);
-  EXPECT_NE(version.error().message().find("version 2"), std::string::npos);
+  EXPECT_NE(version.error().message().find("version 1, this basalt speaks version 2"), std::string::npos)
+      << version.error().message();
 
   bad = b;
   bad[5] = std::byte{9};
@@ -127,6 +138,21 @@ TEST(LockProtocol, MalformedMessagesAreRejectedWithTheReason) {
   auto notFinite = decodeFrame(bytesOf(bad, encode(nan, bad)));
   ASSERT_FALSE(notFinite);
   EXPECT_NE(notFinite.error().message().find("not finite"), std::string::npos);
+
+  // A programme with an unknown mode, display or flags, or reserved bytes that are not zero.
+  constexpr std::size_t kProgrammeAt = kLockHeaderBytes + 24 + kLockedStateBytes;
+  for (const std::size_t at : {kProgrammeAt, kProgrammeAt + 1, kProgrammeAt + 2, kProgrammeAt + 3, kProgrammeAt + 28}) {
+    bad = b;
+    bad[at] = std::byte{0x7f};
+    auto programme = decodeFrame(bytesOf(bad, n));
+    ASSERT_FALSE(programme) << "accepted a programme with byte " << at - kProgrammeAt << " = 0x7f";
+    EXPECT_NE(programme.error().message().find("programme"), std::string::npos) << programme.error().message();
+  }
+  bad = b;
+  bad[kProgrammeAt + 64 + 7] = std::byte{0x80};  // the first movie pass's sign
+  auto pass = decodeFrame(bytesOf(bad, n));
+  ASSERT_FALSE(pass);
+  EXPECT_NE(pass.error().message().find("negative movie pass"), std::string::npos) << pass.error().message();
 
   FrameMessage negative = sampleFrame();
   negative.frame = -3;
@@ -228,7 +254,28 @@ LockSpec followerSpec(int port, std::string name, int leaderTimeoutMs = 2000) {
 
 /// One follower node on its own thread: draws the frames its gate gives until the leader says
 /// bye, or `stopAfter` is drawn (a follower killed mid-show).
+/// A director as the lock sees it: the leader's moves to item 2 ("b") at a chosen frame, a
+/// follower's records the programme it was given and before which frame.
+struct FakeDirector final : public LockedDirector {
+  LockedProgramme programme;
+  std::vector<std::pair<std::int64_t, std::uint32_t>> followed;  // (show time in frames, item index)
+  FakeDirector() {
+    programme.present = true;
+    programme.hasItem = true;
+    programme.mode = 2;
+    programme.setItemName("a");
+  }
+  [[nodiscard]] LockedProgramme lockedProgramme() const override { return programme; }
+  bool followProgramme(const LockedProgramme& p, Nanos showTime) override {
+    if (p == programme && !followed.empty()) return false;
+    programme = p;
+    followed.emplace_back(showTime / std::chrono::milliseconds(16), p.index);
+    return true;
+  }
+};
+
 struct FollowerNode {
+  FakeDirector director;
   std::vector<std::int64_t> frames;
   std::vector<Mat4> globals;  // the show state drawn with each frame
   FrameLockFigures figures;
@@ -243,6 +290,7 @@ struct FollowerNode {
       failure = "cannot create the follower";
       return;
     }
+    (*lock)->setDirector(&director);
     NullOutput output;
     const auto giveUp = std::chrono::steady_clock::now() + std::chrono::seconds(60);
     while (std::chrono::steady_clock::now() < giveUp) {
@@ -265,6 +313,8 @@ struct FollowerNode {
 };
 
 struct LeaderNode {
+  FakeDirector director;
+  std::int64_t switchAt = -1;  // the frame in which the leader's item becomes "b"
   std::vector<Mat4> globals;
   FrameLockFigures figures;
   std::int64_t joined = 0;
@@ -280,11 +330,17 @@ struct LeaderNode {
       failure = lock ? "no event loop" : lock.error().message();
       return;
     }
+    (*lock)->setDirector(&director);
     NullOutput output;
     joined = (*lock)->awaitFollowers(**loop);
     for (std::int64_t f = 0; f < frames; ++f) {
       show.rotateGlobal({1.0f, 0.5f, 0.25f});  // the show moves every frame
       FrameContext context{f, std::chrono::milliseconds(16) * f, f + 1 == frames};
+      if (f == switchAt) {  // a control request's `next`, handled by the leader's director
+        director.programme.index = 1;
+        director.programme.setItemName("b");
+        director.programme.itemStartNs = context.time.count();
+      }
       EXPECT_TRUE((*lock)->beforeDraw(context));
       globals.push_back(show.position().global);
       EXPECT_TRUE((*lock)->afterDraw(context, output));
@@ -463,6 +519,43 @@ TEST(FrameLockStatus, FiguresReachHealthAndMetrics) {
             std::string::npos);
   s.lock.reset();
   EXPECT_EQ(healthJson(s).find("\"lock\""), std::string::npos);
+}
+
+}  // namespace
+}  // namespace basalt::kiosk
+
+namespace basalt::kiosk {
+namespace {
+
+// Makes sure the leader's programme reaches every follower before the frame in which it changed
+// is drawn: an item switched on the leader (a control request's `next`) switches on both
+// followers in that same frame, from the same start. Example failure: the programme applied
+// after the follower's director ran, one frame late.
+TEST(FrameLock, FollowersSwitchItemsInTheLeadersFrame) {
+  const int port = freePortPair() + 6;
+  constexpr std::int64_t kFrames = 120;
+  LeaderNode leader;
+  leader.switchAt = 70;
+  FollowerNode a;
+  FollowerNode b;
+  std::thread ta([&] { a.run(followerSpec(port, "a")); });
+  std::thread tb([&] { b.run(followerSpec(port, "b")); });
+  std::thread tl([&] { leader.run(leaderSpec(port, 2, 2000), kFrames, std::chrono::microseconds(200)); });
+  tl.join();
+  ta.join();
+  tb.join();
+  ASSERT_TRUE(leader.failure.empty()) << leader.failure;
+  for (const FollowerNode* f : {&a, &b}) {
+    ASSERT_EQ(f->frames.size(), static_cast<std::size_t>(kFrames));
+    // The first frame brings the leader's programme ("a"), frame 70 the switch to "b".
+    ASSERT_EQ(f->director.followed.size(), 2U);
+    EXPECT_EQ(f->director.followed[0], (std::pair<std::int64_t, std::uint32_t>{0, 0}));
+    EXPECT_EQ(f->director.followed[1], (std::pair<std::int64_t, std::uint32_t>{70, 1}));
+    EXPECT_EQ(f->director.programme.itemName(), "b");
+    EXPECT_EQ(f->director.programme.itemStartNs, Nanos(std::chrono::milliseconds(16) * 70).count());
+    EXPECT_EQ(f->figures.programmeChanges, 1);
+  }
+  EXPECT_EQ(leader.figures.programmeChanges, 1);
 }
 
 }  // namespace
