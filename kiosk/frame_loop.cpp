@@ -111,6 +111,9 @@ Result<FrameLoopStats> FrameLoop::run() {
         auto got = gate_->nextFrame(loop_, std::chrono::milliseconds(100));
         if (!got) return std::unexpected(got.error());
         next = *got;
+        if (!next) {
+          for (FrameParticipant* p : participants_) p->whileHolding();
+        }
       }
       if (!next || next->end) break;
       frame = next->frame;

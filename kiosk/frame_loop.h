@@ -58,6 +58,10 @@ class FrameParticipant {
   }
   /// \brief After presenting and after the show advanced: metrics, watchdog pings.
   virtual void afterPresent(const FrameContext& frame) { (void)frame; }
+  /// \brief Called about every 100 ms while the loop has no frame to draw and the output holds
+  /// its last picture (a frame-locked follower waiting for its leader): nothing is presented, but
+  /// the service manager's watchdog must still hear that the loop is alive.
+  virtual void whileHolding() {}
   /// \brief True when this participant wants the loop to end after the current frame (a
   /// script's `quit`, the end of a recording). Asked before each frame and again after the
   /// participants' afterDraw(), so that a frame can become the last one while it is made.

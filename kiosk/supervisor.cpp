@@ -81,14 +81,25 @@ void Supervisor::afterPresent(const FrameContext& /*frame*/) {
     notify(status_.empty() ? std::string("READY=1") : "READY=1\nSTATUS=" + status_);
     return;
   }
-  if (watchdog_ && now - lastPing_ >= *watchdog_ / 2) {
-    lastPing_ = now;
-    ++pings_;
-    if (const int rc = sd_notify(0, "WATCHDOG=1"); rc < 0) {
-      static log::Once once;
-      if (once.first()) log::warn(kLogSupervision, "cannot ping the watchdog: {}", std::strerror(-rc));
-    }
+  (void)pingIfDue();
+}
+
+void Supervisor::whileHolding() {
+  // Before the first frame there is nothing to hold, and systemd waits for READY=1 anyway.
+  if (!notifying_ || !ready_) return;
+  if (pingIfDue()) ++holdingPings_;
+}
+
+bool Supervisor::pingIfDue() {
+  const Nanos now = wall_.now();
+  if (!watchdog_ || now - lastPing_ < *watchdog_ / 2) return false;
+  lastPing_ = now;
+  ++pings_;
+  if (const int rc = sd_notify(0, "WATCHDOG=1"); rc < 0) {
+    static log::Once once;
+    if (once.first()) log::warn(kLogSupervision, "cannot ping the watchdog: {}", std::strerror(-rc));
   }
+  return true;
 }
 
 bool stderrIsJournal() {

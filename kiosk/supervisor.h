@@ -32,6 +32,8 @@ class Supervisor final : public FrameParticipant {
   /// \brief How often the manager expects a ping, when it does.
   [[nodiscard]] std::optional<Nanos> watchdogTimeout() const { return watchdog_; }
   [[nodiscard]] std::uint64_t pingsSent() const { return pings_; }
+  /// \brief Watchdog pings sent while the loop held its picture (whileHolding).
+  [[nodiscard]] std::uint64_t pingsWhileHolding() const { return holdingPings_; }
 
   /// \brief STATUS=...; sent only when it changed.
   void status(std::string_view text);
@@ -44,6 +46,9 @@ class Supervisor final : public FrameParticipant {
 
   /// \brief READY=1 after the first frame; a watchdog ping every half timeout.
   void afterPresent(const FrameContext& frame) override;
+  /// \brief A frame-locked follower holding its picture for a lost leader is alive: its loop
+  /// still pings, so that a long leader outage does not get every follower restarted.
+  void whileHolding() override;
 
  private:
   Supervisor(bool notifying, std::optional<Nanos> watchdog);
@@ -55,6 +60,9 @@ class Supervisor final : public FrameParticipant {
   Nanos lastPing_{0};
   bool ready_ = false;
   std::uint64_t pings_ = 0;
+  std::uint64_t holdingPings_ = 0;
+  /// Pings when half the watchdog time has passed since the last; true when it did.
+  bool pingIfDue();
   std::string status_;
 };
 
