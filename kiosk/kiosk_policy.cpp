@@ -153,6 +153,33 @@ bool KioskPolicy::step(int direction, Nanos now) {
 bool KioskPolicy::next(Nanos now) { return step(1, now); }
 bool KioskPolicy::previous(Nanos now) { return step(-1, now); }
 
+bool KioskPolicy::follow(KioskMode mode, DisplayState display, bool hasItem, std::size_t index, std::string_view item,
+                         Nanos itemStart) {
+  const auto& list = listFor(mode);
+  std::size_t at = index;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    if (list[i].name == item) {
+      at = i;
+      break;
+    }
+  }
+  const PlaylistItem* playing = hasItem && at < list.size() ? &list[at] : nullptr;
+  const std::size_t place = playing ? at : 0;
+  if (current_.mode == mode && current_.display == display && current_.item == playing && current_.index == place &&
+      current_.itemStart == itemStart) {
+    return false;
+  }
+  current_.mode = mode;
+  current_.display = display;
+  current_.count = list.size();
+  current_.index = place;
+  current_.item = playing;
+  current_.itemStart = itemStart;
+  failuresInARow_ = 0;
+  ++current_.generation;
+  return true;
+}
+
 ResumePoint KioskPolicy::resumePoint(Nanos now) const {
   ResumePoint p;
   p.mode = current_.mode;

@@ -76,6 +76,11 @@ class KioskPolicy {
   /// (closed, or a list of one).
   bool next(Nanos now);
   bool previous(Nanos now);
+  /// \brief A frame-locked follower plays what its leader plays: `mode`, `display`, and the item
+  /// named `item` (found by name in the mode's list, else at `index`; none when `hasItem` is
+  /// false) since `itemStart`. True when that changed what plays.
+  bool follow(KioskMode mode, DisplayState display, bool hasItem, std::size_t index, std::string_view item,
+              Nanos itemStart);
 
   [[nodiscard]] const Programme& current() const { return current_; }
   [[nodiscard]] Nanos position(Nanos now) const { return now - current_.itemStart; }

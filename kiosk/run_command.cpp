@@ -490,6 +490,15 @@ int runShow(const RunOptions& options) {
   const LockSpec& lockSpec = manifest.lock;
   std::unique_ptr<media::NetClockServer> clockServer;
   std::unique_ptr<media::NetClock> netClock;
+  if (lockSpec.role != LockRole::kOff && lockSpec.clock) {
+    // The shared clock's GStreamer threads start here, before the event loop watches the stop
+    // signals: block those now so that the threads inherit the mask. Otherwise a SIGTERM could
+    // land on a clock thread, whose default action ends the process without its summary.
+    sigset_t stopSignals;
+    sigemptyset(&stopSignals);
+    for (const int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&stopSignals, s);
+    (void)pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
+  }
   if (lockSpec.role == LockRole::kLeader && lockSpec.clock) {
     auto served = media::NetClockServer::start(lockSpec.listen, lockSpec.port + 2);
     if (!served) return failWith(served.error(), "cannot share the clock");
@@ -722,7 +731,28 @@ int runShow(const RunOptions& options) {
       lock->setClockProbe(&*clockProbe);
       lock->setSharedClock(*netClock);
     }
-    lock->setPublisher([&board](const FrameLockFigures& figures) { board.publishLock(figures); });
+    lock->setDirector(&director);
+    // Movies on the group's timeline. A follower waits (bounded) for the movie frame the leader
+    // draws; the leader waits briefly too, so that a decoder a little late does not part its
+    // picture from the followers'.
+    director.setLocked(lock->leader(), std::chrono::milliseconds(lock->leader() ? std::min(spec.timeoutMs, 50)
+                                                                                : std::min(spec.leaderTimeoutMs, 500)));
+    lock->setPublisher([&board, &director, supervision = supervisor.get(), holding = false,
+                        leaderAt = spec.leader](const FrameLockFigures& figures) mutable {
+      FrameLockFigures f = figures;
+      f.watchdogPingsHolding = supervision->pingsWhileHolding();
+      board.publishLock(f);
+      // What `systemctl status` shows: a follower holding for a lost leader says so (its loop
+      // keeps pinging the watchdog meanwhile), and says what plays again once the leader is back.
+      if (f.holding) {
+        holding = true;
+        supervision->status(fmt::format("holding frame {}: the frame-lock leader at {} is lost; waiting for it",
+                                        f.heldFrame, leaderAt));
+      } else if (holding) {
+        holding = false;
+        if (const KioskPolicy* policy = director.policy()) supervision->status(policy->describe());
+      }
+    });
     frameLoop.addParticipant(*lock);
     if (lock->leader()) {
       const std::int64_t joined = lock->awaitFollowers(**loop);

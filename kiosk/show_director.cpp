@@ -146,6 +146,10 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   scheduleForStatus_ = show_->schedule ? std::make_shared<const Schedule>(*show_->schedule) : nullptr;
   policy_->start(now, wall, resume);
   appliedGeneration_ = 0;
+  // A leader's streams start with its show; a follower keeps the leader's start (it comes with
+  // every frame, and a reload of the leader brings a new one).
+  if (!follower_) mediaStart_ = now;
+  if (locked_) alignStreams();
   applyProgramme(now);
   publishDevices();
   publishStreams();
@@ -302,6 +306,13 @@ void ShowDirector::handleControls(const FrameContext& frame) {
     switch (request.kind) {
       case ControlKind::kNext:
       case ControlKind::kPrevious: {
+        if (follower_) {
+          // One director for the group: the leader's. Moving one node would part it from the others.
+          reply.answer(409,
+                       "this node follows its frame-lock leader, which decides what plays: send the request "
+                       "to the leader's control server");
+          break;
+        }
         const bool moved = request.kind == ControlKind::kNext ? policy_->next(now) : policy_->previous(now);
         if (moved) {
           applyProgramme(now);
@@ -460,12 +471,13 @@ void ShowDirector::applyInput(Nanos until) {
                                  return;
                                }
                                // A visitor touched something: wake the exhibit, and count as activity.
-                               if (policy_->noteInput(now)) applyProgramme(now);
+                               if (!follower_ && policy_->noteInput(now)) applyProgramme(now);
                                if (!player_) return;
                                DeviceSlot& slot =
                                    show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
                                if (e.kind == EventKind::kButton) {
                                  if (e.value < 0.5 || e.index >= slot.buttons.size()) return;
+                                 if (follower_ && slot.buttons[e.index] != KioskAction::kResetView) return;
                                  switch (slot.buttons[e.index]) {
                                    case KioskAction::kNextItem:
                                      if (policy_->next(now)) applyProgramme(now);
@@ -489,7 +501,9 @@ void ShowDirector::applyOutputInput(Nanos now) {
       Event& e = input[i];
       e.time = now;
       // A visitor at the keyboard or mouse counts as activity (a press or a move, not a release).
-      if ((e.kind == EventKind::kPointerMotion || e.value > 0.5) && policy_->noteInput(now)) applyProgramme(now);
+      if ((e.kind == EventKind::kPointerMotion || e.value > 0.5) && !follower_ && policy_->noteInput(now)) {
+        applyProgramme(now);
+      }
       if (e.kind == EventKind::kKey && views_ && views_->applyKey(e)) continue;
       if (e.kind == EventKind::kPointerButton) {
         pointerHeld_ = e.value > 0.5;
@@ -568,8 +582,10 @@ void ShowDirector::applyProgramme(Nanos now) {
       }
       if (!started) {
         if (reportedFailures_.insert(key).second) {
-          log::error(kLogDirector, "'{}' cannot play: {}; moving on", p.item->name, started.error().describe());
+          log::error(kLogDirector, "'{}' cannot play: {}; {}", p.item->name, started.error().describe(),
+                     follower_ ? "showing the scene without it until the leader moves on" : "moving on");
         }
+        if (follower_) break;  // the leader decides what plays next
         policy_->itemFailed(now);
         continue;
       }
@@ -620,20 +636,103 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
   applyInput(now);
   applyOutputInput(now);
   advanceShuttles(now);
-  if (policy_->update(now, context_.clock.wallNow())) applyProgramme(now);
+  // A frame-locked follower's programme is the leader's (followProgramme): it decides nothing.
+  if (!follower_ && policy_->update(now, context_.clock.wallNow())) applyProgramme(now);
   if (player_) {
     if (auto r = player_->beforeDraw(frame, context_.show); !r) {
       log::error(kLogDirector, "'{}' stopped: {}; moving on", policy_->current().item->name, r.error().describe());
-      policy_->itemFailed(now);
-      applyProgramme(now);
-    } else if (player_->ended()) {
+      if (follower_) {
+        player_ = nullptr;
+      } else {
+        policy_->itemFailed(now);
+        applyProgramme(now);
+      }
+    } else if (player_->ended() && !follower_) {
       policy_->itemEnded(now);
       applyProgramme(now);
     }
   }
   updateStreams(now);
+  // Which movie frame each texture shows in which frame (BASALT_LOG=kiosk=debug): frame-locked
+  // nodes are compared with it.
+  for (const LoadedTexture& t : show_->textures) {
+    if (!t.stream) continue;
+    if (const std::int64_t shown = t.stream->shownFrame(); shown >= 0) {
+      log::debug(kLogDirector, "frame {}: texture '{}' shows movie '{}' frame {}", frame.frame, t.name, t.source,
+                 shown);
+    }
+  }
   if (now - lastSave_ >= kSaveEvery) saveState(now);
   return {};
+}
+
+void ShowDirector::setLocked(bool leader, std::chrono::milliseconds patience) {
+  locked_ = true;
+  follower_ = !leader;
+  patience_ = patience;
+  if (show_) alignStreams();
+}
+
+void ShowDirector::alignStreams() {
+  for (LoadedTexture& t : show_->textures) {
+    if (t.stream) t.stream->alignTo(mediaStart_, patience_);
+  }
+}
+
+LockedProgramme ShowDirector::lockedProgramme() const {
+  LockedProgramme l;
+  l.present = true;
+  const Programme& p = policy_->current();
+  l.hasItem = p.item != nullptr;
+  l.mode = static_cast<std::uint8_t>(p.mode);
+  l.display = static_cast<std::uint8_t>(p.display);
+  l.index = static_cast<std::uint32_t>(p.index);
+  l.itemStartNs = p.itemStart.count();
+  l.mediaStartNs = mediaStart_.count();
+  l.reloads = static_cast<std::uint32_t>(reloadsApplied_);
+  if (p.item) l.setItemName(p.item->name);
+  std::size_t movie = 0;
+  for (const LoadedTexture& t : show_->textures) {
+    if (!t.stream || movie == l.moviePassNs.size()) continue;
+    l.moviePassNs[movie++] = t.stream->passDuration().count();
+  }
+  return l;
+}
+
+bool ShowDirector::followProgramme(const LockedProgramme& l, Nanos showTime) {
+  if (!follower_ || !policy_) return false;
+  // The leader reloaded its manifest: so does this node (its own copy of the show folder).
+  if (leaderReloads_ && *leaderReloads_ != l.reloads) {
+    log::info(kLogDirector, "the frame-lock leader reloaded its show; reloading this node's");
+    requestReload();
+  }
+  leaderReloads_ = l.reloads;
+  bool changed = false;
+  std::size_t movie = 0;
+  for (LoadedTexture& t : show_->textures) {
+    if (!t.stream || movie == l.moviePassNs.size()) continue;
+    t.stream->setLeaderPass(Nanos{l.moviePassNs[movie++]});
+  }
+  if (Nanos{l.mediaStartNs} != mediaStart_) {
+    mediaStart_ = Nanos{l.mediaStartNs};
+    alignStreams();
+    changed = true;
+  }
+  if (l.mode > 2 || l.display > 2) return changed;  // decodeFrame rejects these
+  const std::string item = l.itemName();
+  if (policy_->follow(static_cast<KioskMode>(l.mode), static_cast<DisplayState>(l.display), l.hasItem, l.index, item,
+                      Nanos{l.itemStartNs})) {
+    const Programme& p = policy_->current();
+    if (l.hasItem && (!p.item || p.item->name != item)) {
+      log::warn(kLogDirector,
+                "the frame-lock leader plays '{}' ({}), which this node's show does not have at that "
+                "place; check that every node has the same show folder",
+                item, l.index + 1);
+    }
+    applyProgramme(showTime);
+    changed = true;
+  }
+  return changed;
 }
 
 void ShowDirector::releaseItemTextures(const std::string& nextKey) {

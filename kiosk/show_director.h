@@ -18,6 +18,7 @@
 
 #include "devices/evdev/evdev_input.h"
 #include "devices/udev/udev_monitor.h"
+#include "kiosk/frame_lock.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/kiosk_policy.h"
 #include "kiosk/show_loader.h"
@@ -54,7 +55,7 @@ struct DirectorContext {
 ///
 /// Threading: everything on the frame loop's thread, except the reload, which reads and loads
 /// the manifest on a thread of its own and hands the result over through `reloadMutex_`.
-class ShowDirector final : public FrameParticipant {
+class ShowDirector final : public FrameParticipant, public LockedDirector {
  public:
   explicit ShowDirector(DirectorContext context);
   ~ShowDirector() override;
@@ -75,6 +76,14 @@ class ShowDirector final : public FrameParticipant {
   /// \brief Keyboards and mice read from evdev (a KMS output has no window to deliver them):
   /// their events go where the window's go. Borrowed; null: none.
   void setKeyboardsAndMice(devices::EvdevInput* input) { keyboardsAndMice_ = input; }
+  /// \brief Frame-locked nodes ([lock]): the show's movie streams play on a timeline that starts
+  /// at a show time the leader gives (its show's start), so that every node shows the same video
+  /// frame; a follower (`leader` false) waits up to `patience` for the frame due, and plays the
+  /// leader's programme (followProgramme) instead of deciding its own.
+  void setLocked(bool leader, std::chrono::milliseconds patience);
+
+  [[nodiscard]] LockedProgramme lockedProgramme() const override;
+  bool followProgramme(const LockedProgramme& programme, Nanos showTime) override;
 
   Result<void> beforeDraw(const FrameContext& frame) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
@@ -115,6 +124,8 @@ class ShowDirector final : public FrameParticipant {
   void cameraRow(DeviceStatus& d, const DeviceSlot& slot) const;
   /// Removes the textures the last item put in the registry, unless `nextKey` is that same item.
   void releaseItemTextures(const std::string& nextKey);
+  /// Frame-locked: puts every movie stream of the show on the timeline from mediaStart_.
+  void alignStreams();
 
   DirectorContext context_;
   DisplayViews* views_ = nullptr;
@@ -159,6 +170,12 @@ class ShowDirector final : public FrameParticipant {
   std::string itemKey_;
   std::vector<std::string> texturesBeforeItem_;
   std::uint64_t performanceUpdates_ = 0;  // the meter's sample last published
+  // Frame lock (frame loop only).
+  bool locked_ = false;
+  bool follower_ = false;  // plays the leader's programme, decides nothing itself
+  std::chrono::milliseconds patience_{0};
+  Nanos mediaStart_{0};  // show time the show's [media] streams start (leader: its show's take-over)
+  std::optional<std::uint32_t> leaderReloads_;  // the leader's reload count last seen
 };
 
 }  // namespace basalt::kiosk

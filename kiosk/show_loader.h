@@ -12,6 +12,8 @@
 /// stay quiet and its texture shows the fallback: the show goes on.
 
 #include <array>
+#include <chrono>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -47,6 +49,25 @@ class TextureStream {
   /// \brief A camera's own state as of the last update() (it can be lost while the texture
   /// still shows something: its on_loss picture); none for streams without a device.
   [[nodiscard]] virtual std::optional<SourceState> deviceState() const { return std::nullopt; }
+  /// \brief Frame-locked nodes: play as if started at show time `origin` (frame 0 due then, the
+  /// frame at `t - origin` due at `t`, looping where the media loops), so that every node shows
+  /// the same frame whenever it started; wait up to `patience` each update for the frame due (a
+  /// follower draws the leader's frame; a manual clock waits anyway). Streams that play no file
+  /// (cameras) ignore it.
+  virtual void alignTo(Nanos origin, std::chrono::milliseconds patience) {
+    (void)origin;
+    (void)patience;
+  }
+  /// \brief Frame-locked: one pass of the leader's loop of this stream (0: unknown yet), for
+  /// placing a late joiner in the right loop (the leader's passes are its file's length, which
+  /// can differ from frames x frame duration by the file's timestamp rounding).
+  virtual void setLeaderPass(Nanos pass) { (void)pass; }
+  /// \brief One pass of this stream's loop on its timeline, once it has looped (0 before, and
+  /// for streams that are not movies).
+  [[nodiscard]] virtual Nanos passDuration() const { return Nanos{0}; }
+  /// \brief The number of the movie frame the last update() showed; -1 before the first, and
+  /// for streams that are not movies.
+  [[nodiscard]] virtual std::int64_t shownFrame() const { return -1; }
 };
 
 using StreamFactory = std::function<Result<std::unique_ptr<TextureStream>>(const MediaSpec& media, const Manifest& show,

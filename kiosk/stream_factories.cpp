@@ -140,9 +140,25 @@ class MovieStream final : public TextureStream {
       texture_ = std::move(*texture);
     }
     // Offline (ManualClock) runs wait for the frame due, so that every frame is exact; a show
-    // on the system clock never waits: the newest frame due is shown, or the last one stays.
-    if (manualClock_) player_->waitForFrameDue(showTime, std::chrono::seconds(10));
-    const FrameRef frame = player_->frameAt(showTime);
+    // on the system clock never waits (the newest frame due is shown, or the last one stays),
+    // except a frame-locked follower, which must draw the leader's frame (bounded).
+    const std::chrono::milliseconds patience = manualClock_ ? std::chrono::milliseconds(10000) : patience_;
+    if (origin_ && !aligned_) {
+      align(showTime, patience);
+      // Nothing before the movie is on the group's timeline: a node that showed the clip's first
+      // frame meanwhile would show another frame than the others.
+      const media::MovieState now = player_->state();
+      if (!aligned_ && now != media::MovieState::kFailed && now != media::MovieState::kEmpty) return false;
+    }
+    if (patience.count() > 0) player_->waitForFrameDue(showTime, patience);
+    FrameRef frame = player_->frameAt(showTime);
+    if (origin_ && frame && patience.count() > 0) {
+      // The frame a seek onto the group's timeline brought is due when the seek was asked for;
+      // a node that waited for it takes the frame due now as well, so that it shows what the
+      // others show in this very frame.
+      player_->waitForFrameDue(showTime, patience);
+      if (FrameRef newer = player_->frameAt(showTime)) frame = std::move(newer);
+    }
     const media::MovieState state = player_->state();
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) {
       if (!reportedFailure_) {
@@ -166,6 +182,20 @@ class MovieStream final : public TextureStream {
     return true;
   }
 
+  void alignTo(Nanos origin, std::chrono::milliseconds patience) override {
+    if (origin_ == origin && patience_ == patience) return;
+    origin_ = origin;
+    patience_ = patience;
+    aligned_ = false;
+  }
+
+  void setLeaderPass(Nanos pass) override { leaderPass_ = pass; }
+  [[nodiscard]] Nanos passDuration() const override { return started_ ? player_->passDuration() : Nanos{0}; }
+
+  [[nodiscard]] std::int64_t shownFrame() const override {
+    return started_ && failure_.empty() ? player_->currentFrame() : -1;
+  }
+
   [[nodiscard]] std::string describe() const override {
     if (!failure_.empty()) return fmt::format("movie {}: {}", media_.file.filename(), failure_);
     const media::MovieInfo info = player_->info();
@@ -176,10 +206,46 @@ class MovieStream final : public TextureStream {
   }
 
  private:
+  /// Seeks to the frame due at `showTime` on the timeline that starts at origin_, due at the
+  /// show time that frame belongs to (not when the seek lands), once the clip's length is known.
+  void align(Nanos showTime, std::chrono::milliseconds patience) {
+    // Opening takes longer than a frame: the first time, wait up to a second for it.
+    // (Not loaded yet: the next update tries again; failed: update() reports it.)
+    if (!player_->waitUntilLoaded(std::max(patience, std::chrono::milliseconds(1000)))) return;
+    if (player_->state() != media::MovieState::kReady) return;
+    const Nanos frame = player_->info().frameDuration;
+    if (frame <= Nanos{0}) return;
+    // The leader's timeline: show time t is at t - origin, a loop's frames at its pass's start
+    // plus their timestamps, each pass one leader pass long.
+    const Nanos elapsed = std::max(Nanos{0}, showTime - *origin_);
+    const std::int64_t count = player_->frameCount();
+    Nanos passStart{0};
+    if (media_.loop && leaderPass_ > Nanos{0}) {
+      passStart = (elapsed / leaderPass_) * leaderPass_;
+    } else if (media_.loop && count > 0 && elapsed >= frame * count) {
+      passStart = (elapsed / (frame * count)) * (frame * count);  // the leader's pass is not known yet
+    }
+    // The frame due is the last whose timestamp is at most the time (plus the player's 1.5 ms for
+    // rounded timestamps); timestamps sit up to half a millisecond off the frame grid, so take the
+    // one before when in doubt: the update after the seek takes the next if it is due, by the same
+    // timestamps the leader reads.
+    std::int64_t index = std::max<std::int64_t>(0, (elapsed - passStart + std::chrono::microseconds(1000)) / frame);
+    if (count > 0) index = std::min(index, count - 1);
+    const Nanos timeline = passStart + frame * index;
+    player_->seekFrameDueAt(index, *origin_ + timeline, timeline);
+    aligned_ = true;
+    log::debug(kLogStreams, "movie '{}' joins the group's timeline at show time {:.3f} s: frame {}", media_.name,
+               toSeconds(showTime), index);
+  }
+
   MediaSpec media_;
   std::unique_ptr<media::MoviePlayer> player_;
   std::unique_ptr<render::StreamTexture> texture_;
   bool manualClock_;
+  std::optional<Nanos> origin_;            // frame-locked: the show time of frame 0
+  std::chrono::milliseconds patience_{0};  // frame-locked follower: how long to wait for a frame
+  bool aligned_ = false;                   // the seek onto the group's timeline is asked for
+  Nanos leaderPass_{0};                    // frame-locked follower: the leader's pass of this loop (0: unknown)
   bool started_ = false;
   bool reportedFailure_ = false;
   std::string failure_;
