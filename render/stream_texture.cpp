@@ -129,7 +129,8 @@ void setSampling(GLenum filter) {
 /// The conversion program for one layout.
 struct ConversionProgram {
   gl::Program program;
-  GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1, flipX = -1, chromaScale = -1, mirrorWidth = -1;
+  GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1, flipX = -1, chromaScale = -1,
+        mirrorWidth = -1;
 };
 
 /// yuv.frag with LAYOUT defined: one program per layout, so no pixel runs a branch.
