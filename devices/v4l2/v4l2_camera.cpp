@@ -34,6 +34,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
@@ -261,6 +262,7 @@ class V4l2Camera final : public VideoSource {
   UniqueFd stopFd_;
   std::thread thread_;
   bool dvTimings_ = false;
+  std::optional<v4l2_dv_timings> timings_;  // what the receiver was set to, while streaming
   v4l2_pix_format fmt_{};
   VideoMode mode_{};
   BufferSet* buffers_ = nullptr;  // capture thread (and open/close) only
@@ -355,6 +357,7 @@ Result<void> V4l2Camera::negotiate(bool* noSignal) {
     }
     width = t.bt.width;
     height = t.bt.height;
+    timings_ = t;
   }
   // Choose a format: the one asked for, else the device's best that Basalt handles.
   std::vector<std::uint32_t> offered;
@@ -560,6 +563,17 @@ void V4l2Camera::handleEvents() {
     if (ev.type == V4L2_EVENT_SOURCE_CHANGE) sourceChanged = true;
   }
   if (!sourceChanged) return;
+  if (buffers_ && timings_) {
+    // A source change that leaves the timings as they are (a source re-sending its mode, a
+    // control touched) needs no renegotiation: capture goes on without a gap.
+    v4l2_dv_timings now{};
+    if (xioctl(fd_.get(), VIDIOC_QUERY_DV_TIMINGS, &now) == 0 && now.bt.width == timings_->bt.width &&
+        now.bt.height == timings_->bt.height && now.bt.interlaced == timings_->bt.interlaced &&
+        now.bt.pixelclock == timings_->bt.pixelclock) {
+      log::debug(kLogV4l2, "{}: the HDMI source changed nothing; capture goes on", path_);
+      return;
+    }
+  }
   reportLost(Error(Errc::kUnavailable, "the HDMI source changed; renegotiating", path_), true);
   std::lock_guard lock(controlMutex_);
   stopStreaming(true);

@@ -83,6 +83,8 @@ TEST(V4l2Hardware, HdmiSignalLossAndResolutionChangeRenegotiate) {
   EXPECT_TRUE(changed) << "no resolution change was renegotiated; lost: "
                        << (source->lostReason() ? source->lostReason()->describe() : "no");
   source->close();
+  // The input as the lab's other cases expect it: a steady signal on the current timings.
+  EXPECT_TRUE(setV4l2ControlByName(*node, "DV Timings Signal Mode", 0));
 }
 
 TEST(V4l2Hardware, EnumerationDescribesTheWebcam) {
