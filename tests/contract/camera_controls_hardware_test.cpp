@@ -1,6 +1,7 @@
 // LAVA's "Hardware" panel on a real V4L2 device, in the virtual lab (skipping with the reason
 // elsewhere): the input (port) a camera is opened on, and the JPEG quality control. vivid's
-// webcam and HDMI instances have one input each; vivid has no JPEG quality control, and neither
+// webcam and HDMI instances have one input each and its third instance two (a camera switched
+// between them); vivid has no JPEG quality control, and neither
 // has the UVC gadget, so the "device that has it" case skips with that reason unless a lab camera
 // offers one.
 // Example failures: an input that does not exist opened silently on another one, or refused
@@ -14,8 +15,10 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -31,7 +34,7 @@ namespace {
 /// The lab's vivid nodes: {variable, node}.
 std::vector<std::pair<std::string, std::string>> vividNodes() {
   std::vector<std::pair<std::string, std::string>> out;
-  for (const char* v : {"BASALT_VLAB_V4L2_WEBCAM", "BASALT_VLAB_V4L2_HDMI"}) {
+  for (const char* v : {"BASALT_VLAB_V4L2_WEBCAM", "BASALT_VLAB_V4L2_HDMI", "BASALT_VLAB_V4L2_INPUTS"}) {
     if (auto node = test::vlabEnv(v)) out.emplace_back(v, *node);
   }
   return out;
@@ -87,7 +90,25 @@ TEST(V4l2Controls, InputThatExistsOpensAndOneThatDoesNotSaysWhich) {
     auto now = describeV4l2Device(node);
     ASSERT_TRUE(now) << now.error().describe();
     EXPECT_EQ(now->currentInput, last);
+    // And it streams from there.
+    const auto start = std::chrono::steady_clock::now();
+    while (camera->framesDelivered() < 3 && std::chrono::steady_clock::now() - start < std::chrono::seconds(10)) {
+      camera->service(clock.now());
+      (void)camera->frameAt(clock.now());
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    EXPECT_GE(camera->framesDelivered(), 3u) << "frames from input " << last;
     camera->close();
+    if (last > 0) {
+      // Back to the first input: a camera opened on input 0 switches the device there.
+      options.input = 0;
+      auto first = makeV4l2Camera(node, options, clock);
+      ASSERT_TRUE(first->open(3));
+      auto back = describeV4l2Device(node);
+      ASSERT_TRUE(back) << back.error().describe();
+      EXPECT_EQ(back->currentInput, 0);
+      first->close();
+    }
 
     options.input = static_cast<int>(d->inputs.size());  // one past the last
     auto missing = makeV4l2Camera(node, options, clock);

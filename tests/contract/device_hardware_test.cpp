@@ -310,13 +310,19 @@ TEST(HotplugHardware, LibcameraUvcUnpluggedAndReplugged) {
     GTEST_SKIP() << test::needsVlab("BASALT_VLAB_V4L2_UVC and BASALT_VLAB_GADGET_CTL");
   }
   std::string model;
-  {
+  // The camera may be coming back from the case before (udev processes it before libcamera
+  // lists it): wait a while for it.
+  for (int attempt = 0; attempt < 20 && model.empty(); ++attempt) {
     LibcameraProvider probe;
     if (!probe.startError().empty()) GTEST_SKIP() << probe.startError();
     const auto cameras = probe.enumerate();
-    if (cameras.empty()) GTEST_SKIP() << "libcamera sees no camera, not even the lab's UVC camera";
-    model = cameras.front().info.name;
+    if (!cameras.empty()) {
+      model = cameras.front().info.name;
+    } else {
+      std::this_thread::sleep_for(500ms);
+    }
   }
+  if (model.empty()) GTEST_SKIP() << "libcamera sees no camera after 10 s, not even the lab's UVC camera";
   DeviceMatch m;
   m.backend = "libcamera";
   m.name = model;

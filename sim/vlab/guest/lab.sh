@@ -97,9 +97,9 @@ else
   fixture_fail loopback "cannot bring lo up: the status-server cases cannot connect"
 fi
 
-# ---- V4L2: vivid, instance 0 a webcam, instance 1 an HDMI input ----------------------------
+# ---- V4L2: vivid, instance 0 a webcam, instance 1 an HDMI input, instance 2 two webcams ---------
 # node_types 0x1: a video capture node only; input_types: 2 bits per input, 00 webcam, 11 HDMI.
-if load vivid n_devs=2 node_types=0x1,0x1 num_inputs=1,1 input_types=0x0,0x3; then
+if load vivid n_devs=3 node_types=0x1,0x1,0x1 num_inputs=1,1,2 input_types=0x0,0x3,0x0; then
   if webcam=$(video_node_named vivid-000-vid-cap); then
     setenv BASALT_VLAB_V4L2_WEBCAM "$webcam"
     fixture_ok webcam "$webcam (vivid instance 0, input 0: webcam)"
@@ -111,6 +111,12 @@ if load vivid n_devs=2 node_types=0x1,0x1 num_inputs=1,1 input_types=0x0,0x3; th
     fixture_ok hdmi "$hdmi (vivid instance 1, input 0: HDMI with DV timings)"
   else
     fixture_fail hdmi "vivid loaded but no vivid-001-vid-cap node"
+  fi
+  if inputs=$(video_node_named vivid-002-vid-cap); then
+    setenv BASALT_VLAB_V4L2_INPUTS "$inputs"
+    fixture_ok inputs "$inputs (vivid instance 2: two webcam inputs)"
+  else
+    fixture_fail inputs "vivid loaded but no vivid-002-vid-cap node"
   fi
 else
   fixture_fail webcam "modprobe vivid failed: $(tail -1 "$hr/modprobe.log")"
