@@ -27,8 +27,6 @@ constexpr Nanos kMaxRetry = std::chrono::seconds(30);
 
 }  // namespace
 
-ShowDirector::ShowDirector(DirectorContext context) : context_(context) { context_.board.setShowClock(context_.clock); }
-
 /// A dial box's open on the device thread; `result` is written before `done`.
 struct PendingOpen {
   std::atomic<bool> done{false};
@@ -82,6 +80,8 @@ class ShowDirector::DeviceThread {
   bool stopping_ = false;                    // guarded by mutex_
   std::thread thread_;                       // last: starts once the rest is built
 };
+
+ShowDirector::ShowDirector(DirectorContext context) : context_(context) { context_.board.setShowClock(context_.clock); }
 
 ShowDirector::~ShowDirector() {
   if (udev_) udev_->stop();
