@@ -110,9 +110,9 @@ int main(int argc, char** argv) {
   }
   argc = kept;
   const double minTime = quick ? 0.2 : 2.0;
-  benchmark::RegisterBenchmark("plainOne", plainOne)->Unit(benchmark::kMillisecond)->MinTime(minTime);
-  benchmark::RegisterBenchmark("plainSix", plainSix)->Unit(benchmark::kMillisecond)->MinTime(minTime);
-  benchmark::RegisterBenchmark("facetSix", facetSix)->Unit(benchmark::kMillisecond)->MinTime(minTime);
+  benchmark::RegisterBenchmark("plainOne", plainOne)->Unit(benchmark::kMillisecond)->MinTime(minTime)->Repetitions(3);
+  benchmark::RegisterBenchmark("plainSix", plainSix)->Unit(benchmark::kMillisecond)->MinTime(minTime)->Repetitions(3);
+  benchmark::RegisterBenchmark("facetSix", facetSix)->Unit(benchmark::kMillisecond)->MinTime(minTime)->Repetitions(3);
   return basalt::bench::runBenchmarks(argc, argv, [](const basalt::bench::Medians& m) {
     // Google Benchmark appends "/min_time:..." to the names.
     const auto find = [&m](const std::string& name) {
