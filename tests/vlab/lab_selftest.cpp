@@ -150,9 +150,9 @@ const std::vector<std::uint8_t> kDialDescriptor = {
 TEST(LabEnvironment, EveryContractVariableIsSetAndWellFormed) {
   NEED_LAB();
   EXPECT_EQ(env("BASALT_VLAB"), "1");
-  for (const char* node : {"BASALT_VLAB_V4L2_WEBCAM", "BASALT_VLAB_V4L2_HDMI", "BASALT_VLAB_V4L2_INPUTS",
-                           "BASALT_VLAB_V4L2_UVC",
-                           "BASALT_VLAB_HID_DIAL_GADGET", "BASALT_VLAB_HID_POWERMATE_GADGET", "BASALT_VLAB_DRM"}) {
+  for (const char* node :
+       {"BASALT_VLAB_V4L2_WEBCAM", "BASALT_VLAB_V4L2_HDMI", "BASALT_VLAB_V4L2_INPUTS", "BASALT_VLAB_V4L2_UVC",
+        "BASALT_VLAB_HID_DIAL_GADGET", "BASALT_VLAB_HID_POWERMATE_GADGET", "BASALT_VLAB_DRM"}) {
     struct stat st{};
     EXPECT_EQ(::stat(env(node).c_str(), &st), 0) << node << "=" << env(node);
     EXPECT_TRUE(S_ISCHR(st.st_mode)) << node << "=" << env(node) << " is not a character device";
