@@ -36,7 +36,8 @@ struct EvdevCapabilities {
   template <std::size_t N>
   static std::bitset<N> fromBytes(std::span<const std::uint8_t> bytes) {
     std::bitset<N> bits;
-    for (std::size_t i = 0; i < N && i / 8 < bytes.size(); ++i) bits[i] = ((bytes[i / 8] >> (i % 8)) & 1U) != 0;
+    for (std::size_t i = 0; i < N && i / 8 < bytes.size(); ++i)
+      bits[i] = ((static_cast<unsigned>(bytes[i / 8]) >> (i % 8)) & 1U) != 0;
     return bits;
   }
 };
