@@ -25,6 +25,7 @@
 #include <thread>
 
 #include "render/kiosk_process.h"
+#include "support/datagram_socket.h"
 #include "support/test_paths.h"
 
 namespace basalt {
@@ -151,59 +152,12 @@ TEST(LockedKiosk, NextOnTheLeaderSwitchesTheFollowerInTheSameFrame) {
   EXPECT_NE(lr.output.find("1 programme changes sent"), std::string::npos) << lr.output;
 }
 
-/// A folder of its own under /tmp for the notify socket: a socket's path must fit sun_path.
-class SocketDir {
+using test::SocketDir;
+
+/// systemd's notify socket, as a datagram socket the test reads, counting watchdog pings.
+class NotifySocket : public test::DatagramSocket {
  public:
-  SocketDir() {
-    char name[] = "/tmp/basalt-lock-XXXXXX";
-    if (::mkdtemp(name)) path_ = name;
-  }
-  ~SocketDir() {
-    std::error_code ec;
-    if (!path_.empty()) std::filesystem::remove_all(path_, ec);
-  }
-  SocketDir(const SocketDir&) = delete;
-  SocketDir& operator=(const SocketDir&) = delete;
-  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
-
-/// systemd's notify socket, as a datagram socket the test reads.
-class NotifySocket {
- public:
-  explicit NotifySocket(std::filesystem::path path) : path_(std::move(path)) {
-    sockaddr_un address{};
-    if (path_.native().size() >= sizeof address.sun_path) return;
-    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    address.sun_family = AF_UNIX;
-    std::memcpy(address.sun_path, path_.c_str(), path_.native().size() + 1);
-    bound_ = ::bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0;
-  }
-  ~NotifySocket() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  NotifySocket(const NotifySocket&) = delete;
-  NotifySocket& operator=(const NotifySocket&) = delete;
-  [[nodiscard]] bool bound() const { return bound_; }
-  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
-
-  std::optional<std::string> receive(std::chrono::milliseconds limit) {
-    pollfd p{fd_, POLLIN, 0};
-    if (::poll(&p, 1, static_cast<int>(limit.count())) <= 0) return std::nullopt;
-    char buffer[4096];
-    const ssize_t n = ::recv(fd_, buffer, sizeof buffer, 0);
-    if (n < 0) return std::nullopt;
-    return std::string(buffer, static_cast<std::size_t>(n));
-  }
-  bool waitFor(const std::string& needle, std::chrono::milliseconds limit) {
-    const auto end = std::chrono::steady_clock::now() + limit;
-    while (std::chrono::steady_clock::now() < end) {
-      if (auto d = receive(100ms); d && d->find(needle) != std::string::npos) return true;
-    }
-    return false;
-  }
+  using DatagramSocket::DatagramSocket;
   /// Counts WATCHDOG=1 pings for `span`; `seen` collects every datagram.
   int countPings(std::chrono::milliseconds span, std::string& seen) {
     int pings = 0;
@@ -216,11 +170,6 @@ class NotifySocket {
     }
     return pings;
   }
-
- private:
-  std::filesystem::path path_;
-  int fd_ = -1;
-  bool bound_ = false;
 };
 
 TEST(LockedKiosk, AFollowerHoldingForALostLeaderKeepsPingingTheWatchdog) {
