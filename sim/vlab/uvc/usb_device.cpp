@@ -23,4 +23,18 @@ UsbSetup UsbSetup::fromBytes(std::span<const std::uint8_t, 8> b) {
   return s;
 }
 
+ControlReply controlReply(std::vector<std::uint8_t> data, std::uint16_t wLength) {
+  if (data.size() > wLength) data.resize(wLength);
+  return {UsbStatus::kOk, std::move(data)};
+}
+
+std::vector<std::uint8_t> stringDescriptor(const std::string& text) {
+  std::vector<std::uint8_t> d{static_cast<std::uint8_t>(2 + 2 * text.size()), usb::kDescString};
+  for (const char c : text) {
+    d.push_back(static_cast<std::uint8_t>(c));
+    d.push_back(0);
+  }
+  return d;
+}
+
 }  // namespace basalt::sim::vlab

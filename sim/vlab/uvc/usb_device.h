@@ -18,6 +18,28 @@
 
 namespace basalt::sim::vlab {
 
+/// \brief USB 2.0 chapter 9: the standard requests and descriptor types the lab's device
+/// models answer.
+namespace usb {
+constexpr std::uint8_t kGetStatus = 0x00;
+constexpr std::uint8_t kClearFeature = 0x01;
+constexpr std::uint8_t kSetFeature = 0x03;
+constexpr std::uint8_t kSetAddress = 0x05;
+constexpr std::uint8_t kGetDescriptor = 0x06;
+constexpr std::uint8_t kGetConfiguration = 0x08;
+constexpr std::uint8_t kSetConfiguration = 0x09;
+constexpr std::uint8_t kGetInterface = 0x0a;
+constexpr std::uint8_t kSetInterface = 0x0b;
+constexpr std::uint8_t kDescDevice = 1;
+constexpr std::uint8_t kDescConfiguration = 2;
+constexpr std::uint8_t kDescString = 3;
+constexpr std::uint8_t kDescInterface = 4;
+constexpr std::uint8_t kDescEndpoint = 5;
+constexpr std::uint8_t kDescInterfaceAssociation = 11;
+constexpr std::uint16_t kFeatureEndpointHalt = 0;
+constexpr std::uint16_t kFeatureRemoteWakeup = 1;
+}  // namespace usb
+
 /// \brief The 8-byte SETUP packet of a control transfer (USB 2.0, 9.3).
 struct UsbSetup {
   std::uint8_t requestType = 0;  ///< bmRequestType: bit 7 direction (1 = IN), bits 5-6 type, 0-4 recipient
@@ -52,6 +74,11 @@ struct ControlReply {
 
   static ControlReply stall() { return {UsbStatus::kStall, {}}; }
 };
+
+/// \brief An IN control transfer's answer: `data`, cut to the `wLength` the host asked for.
+ControlReply controlReply(std::vector<std::uint8_t> data, std::uint16_t wLength);
+/// \brief A string descriptor of `text` (ASCII, as UTF-16LE).
+std::vector<std::uint8_t> stringDescriptor(const std::string& text);
 
 /// \brief The result of an IN transfer that completed: how many bytes of the buffer it filled.
 struct InCompletion {

@@ -11,20 +11,7 @@
 namespace basalt::sim::vlab {
 namespace {
 
-constexpr std::uint8_t kGetStatus = 0x00;
-constexpr std::uint8_t kClearFeature = 0x01;
-constexpr std::uint8_t kSetFeature = 0x03;
-constexpr std::uint8_t kSetAddress = 0x05;
-constexpr std::uint8_t kGetDescriptor = 0x06;
-constexpr std::uint8_t kGetConfiguration = 0x08;
-constexpr std::uint8_t kSetConfiguration = 0x09;
-constexpr std::uint8_t kGetInterface = 0x0a;
-constexpr std::uint8_t kSetInterface = 0x0b;
-constexpr std::uint8_t kDescDevice = 1;
-constexpr std::uint8_t kDescConfiguration = 2;
-constexpr std::uint8_t kDescString = 3;
-constexpr std::uint8_t kDescInterface = 4;
-constexpr std::uint8_t kDescEndpoint = 5;
+using namespace usb;  // USB 2.0 chapter 9
 constexpr std::uint8_t kDescHid = 0x21;
 constexpr std::uint8_t kDescReport = 0x22;
 constexpr std::uint8_t kHidSetIdle = 0x0a;
@@ -38,20 +25,7 @@ constexpr std::uint16_t kLedPulseDuringSleep = 0x0002;
 constexpr std::uint16_t kLedPulseAlways = 0x0003;
 constexpr std::uint16_t kLedPulseSpeed = 0x0004;
 
-std::vector<std::uint8_t> stringDescriptor(const std::string& s) {
-  std::vector<std::uint8_t> d{static_cast<std::uint8_t>(2 + 2 * s.size()), kDescString};
-  for (const char c : s) {
-    d.push_back(static_cast<std::uint8_t>(c));
-    d.push_back(0);
-  }
-  return d;
-}
-
-ControlReply reply(const std::vector<std::uint8_t>& data, std::uint16_t wLength) {
-  ControlReply r;
-  r.data.assign(data.begin(), data.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(data.size(), wLength)));
-  return r;
-}
+ControlReply reply(const std::vector<std::uint8_t>& data, std::uint16_t wLength) { return controlReply(data, wLength); }
 
 ControlReply ok() { return {UsbStatus::kOk, {}}; }
 

@@ -15,24 +15,7 @@
 namespace basalt::sim::vlab {
 namespace {
 
-// USB 2.0 chapter 9.
-constexpr std::uint8_t kGetStatus = 0x00;
-constexpr std::uint8_t kClearFeature = 0x01;
-constexpr std::uint8_t kSetFeature = 0x03;
-constexpr std::uint8_t kSetAddress = 0x05;
-constexpr std::uint8_t kGetDescriptor = 0x06;
-constexpr std::uint8_t kGetConfiguration = 0x08;
-constexpr std::uint8_t kSetConfiguration = 0x09;
-constexpr std::uint8_t kGetInterface = 0x0a;
-constexpr std::uint8_t kSetInterface = 0x0b;
-constexpr std::uint8_t kDescDevice = 1;
-constexpr std::uint8_t kDescConfiguration = 2;
-constexpr std::uint8_t kDescString = 3;
-constexpr std::uint8_t kDescInterface = 4;
-constexpr std::uint8_t kDescEndpoint = 5;
-constexpr std::uint8_t kDescInterfaceAssociation = 11;
-constexpr std::uint16_t kFeatureEndpointHalt = 0;
-constexpr std::uint16_t kFeatureRemoteWakeup = 1;
+using namespace usb;  // USB 2.0 chapter 9
 
 // UVC 1.1 appendix A.
 constexpr std::uint8_t kClassVideo = 0x0e;
@@ -105,18 +88,8 @@ class Bytes {
   std::vector<std::uint8_t> v_;
 };
 
-std::vector<std::uint8_t> stringDescriptor(const std::string& s) {
-  std::vector<std::uint8_t> d{static_cast<std::uint8_t>(2 + 2 * s.size()), kDescString};
-  for (const char c : s) {
-    d.push_back(static_cast<std::uint8_t>(c));
-    d.push_back(0);
-  }
-  return d;
-}
-
 ControlReply reply(std::vector<std::uint8_t> data, std::uint16_t wLength) {
-  if (data.size() > wLength) data.resize(wLength);
-  return {UsbStatus::kOk, std::move(data)};
+  return controlReply(std::move(data), wLength);
 }
 
 ControlReply reply16(unsigned v, std::uint16_t wLength) {
