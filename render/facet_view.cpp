@@ -2,6 +2,9 @@
 
 #include <GLES3/gl3.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "embedded/render_shaders.h"
 #include "render/gl.h"
 
@@ -25,29 +28,98 @@ std::array<Viewport, 2> stereoViewports(const Viewport& v, runtime::StereoMode m
   return {v, v};
 }
 
+namespace {
+
+/// One half-plane a x + b y + c >= 0 (inside the facet), in normalised device coordinates.
+struct HalfPlane {
+  float a = 0, b = 0, c = 0;
+  [[nodiscard]] float at(const Vec2& p) const { return a * p.x + b * p.y + c; }
+};
+
+/// The piece of the square -1..1 outside one half-plane (where it is below zero), clipped by
+/// Sutherland and Hodgman's rule: the four corners give at most five.
+std::size_t outsidePiece(const HalfPlane& h, std::array<Vec2, 5>& piece) {
+  static constexpr std::array<Vec2, 4> kSquare = {Vec2{-1, -1}, Vec2{1, -1}, Vec2{1, 1}, Vec2{-1, 1}};
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < kSquare.size(); ++i) {
+    const Vec2& p = kSquare[i];
+    const Vec2& q = kSquare[(i + 1) % kSquare.size()];
+    const float hp = h.at(p), hq = h.at(q);
+    if (hp <= 0) piece[n++] = p;
+    if ((hp < 0 && hq > 0) || (hp > 0 && hq < 0)) {
+      const float t = hp / (hp - hq);
+      piece[n++] = Vec2{p.x + (q.x - p.x) * t, p.y + (q.y - p.y) * t};
+    }
+  }
+  return n;
+}
+
+/// The pixels of `viewport` a convex outline (in normalised device coordinates) can touch, a
+/// pixel wider on each side than its bounding box; an outline that is not one: the viewport.
+Viewport outlineBounds(std::span<const Vec2> outline, const Viewport& viewport) {
+  if (outline.size() < 3) return viewport;
+  float x0 = 1, y0 = 1, x1 = -1, y1 = -1;
+  for (const Vec2& p : outline) {
+    x0 = std::min(x0, p.x), y0 = std::min(y0, p.y);
+    x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+  }
+  x0 = std::max(x0, -1.0f), y0 = std::max(y0, -1.0f);
+  x1 = std::min(x1, 1.0f), y1 = std::min(y1, 1.0f);
+  if (x1 <= x0 || y1 <= y0) return {viewport.x, viewport.y, 1, 1};
+  const auto w = static_cast<float>(viewport.width), h = static_cast<float>(viewport.height);
+  const auto left = static_cast<std::int64_t>(std::floor((x0 + 1) * 0.5f * w)) - 1;
+  const auto bottom = static_cast<std::int64_t>(std::floor((y0 + 1) * 0.5f * h)) - 1;
+  const auto right = static_cast<std::int64_t>(std::ceil((x1 + 1) * 0.5f * w)) + 1;
+  const auto top = static_cast<std::int64_t>(std::ceil((y1 + 1) * 0.5f * h)) + 1;
+  const std::int64_t cl = std::clamp<std::int64_t>(left, 0, viewport.width);
+  const std::int64_t cb = std::clamp<std::int64_t>(bottom, 0, viewport.height);
+  const std::int64_t cr = std::clamp<std::int64_t>(right, cl, viewport.width);
+  const std::int64_t ct = std::clamp<std::int64_t>(top, cb, viewport.height);
+  return {viewport.x + static_cast<std::int32_t>(cl), viewport.y + static_cast<std::int32_t>(cb),
+          static_cast<std::uint32_t>(cr - cl), static_cast<std::uint32_t>(ct - cb)};
+}
+
+/// The smallest rectangle holding both.
+Viewport boundsUnion(const Viewport& a, const Viewport& b) {
+  if (a.width == 0 || a.height == 0) return b;
+  if (b.width == 0 || b.height == 0) return a;
+  const std::int64_t x0 = std::min(a.x, b.x), y0 = std::min(a.y, b.y);
+  const std::int64_t x1 = std::max(std::int64_t{a.x} + a.width, std::int64_t{b.x} + b.width);
+  const std::int64_t y1 = std::max(std::int64_t{a.y} + a.height, std::int64_t{b.y} + b.height);
+  return {static_cast<std::int32_t>(x0), static_cast<std::int32_t>(y0), static_cast<std::uint32_t>(x1 - x0),
+          static_cast<std::uint32_t>(y1 - y0)};
+}
+
+}  // namespace
+
 struct BorderMask::Gpu {
   gl::Program program;
   gl::VertexArray vao;
-  GLint rect = -1, viewportRect = -1, edges = -1, edgeCount = -1;
-  std::array<float, kMaxCorners * 3> edgeValues{};
+  gl::Buffer vertices;
+  /// Up to three triangles a half-plane, two floats a corner.
+  static constexpr std::size_t kMaxFloats = kMaxCorners * 9 * 2;
+  std::array<float, kMaxFloats> values{};
 };
 
 BorderMask::BorderMask() = default;
 BorderMask::~BorderMask() = default;
 
 Result<std::unique_ptr<BorderMask>> BorderMask::create() {
-  auto program = gl::buildProgram(shaders::kQuadVert, shaders::kBorderFrag, "facet border");
+  auto program = gl::buildProgram(shaders::kBorderVert, shaders::kBorderFrag, "facet border");
   if (!program) return std::unexpected(program.error());
   std::unique_ptr<BorderMask> mask(new BorderMask);
   mask->gpu_ = std::make_unique<Gpu>();
   Gpu& g = *mask->gpu_;
   g.program = std::move(*program);
   g.vao = gl::VertexArray::create();
-  const GLuint p = g.program.id();
-  g.rect = glGetUniformLocation(p, "uRect");
-  g.viewportRect = glGetUniformLocation(p, "uViewportRect");
-  g.edges = glGetUniformLocation(p, "uEdges");
-  g.edgeCount = glGetUniformLocation(p, "uEdgeCount");
+  g.vertices = gl::Buffer::create();
+  glBindVertexArray(g.vao.id());
+  glBindBuffer(GL_ARRAY_BUFFER, g.vertices.id());
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(sizeof(g.values)), nullptr, GL_STREAM_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
   return mask;
 }
 
@@ -64,21 +136,34 @@ void BorderMask::draw(std::span<const Vec2> polygon, const Viewport& viewport, c
     area += a.x * b.y - b.x * a.y;
   }
   const float sign = area >= 0 ? 1.0f : -1.0f;
+  // The border is the union of the pieces of the viewport outside each edge's half-plane: drawn
+  // as triangles, it costs only the border's pixels (a full-viewport pass testing every pixel
+  // against every edge cost more than the scene itself on a software GL). The pieces overlap
+  // near the corners, so no pixel outside the outline can fall between two of them.
+  const float onEdge = 0.125f / static_cast<float>(std::max(viewport.width, viewport.height));
+  std::size_t floats = 0;
+  const auto addPiece = [&g, &floats](const HalfPlane& h) {
+    std::array<Vec2, 5> piece{};
+    const std::size_t corners = outsidePiece(h, piece);
+    for (std::size_t k = 1; k + 1 < corners; ++k) {
+      for (const Vec2& p : {piece[0], piece[k], piece[k + 1]}) {
+        g.values[floats++] = p.x;
+        g.values[floats++] = p.y;
+      }
+    }
+  };
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2& a = polygon[i];
     const Vec2& b = polygon[(i + 1) % n];
     // Inside is to the left of a->b for a counter-clockwise outline: -(b-a).y x + (b-a).x y + c.
+    // A pixel whose centre lies on the outline belongs to the facet: each piece starts a
+    // sixteenth of a pixel beyond the edge (finer than the rasteriser's snapping can tell).
     const float nx = -(b.y - a.y) * sign, ny = (b.x - a.x) * sign;
-    g.edgeValues[i * 3] = nx;
-    g.edgeValues[i * 3 + 1] = ny;
-    g.edgeValues[i * 3 + 2] = -(nx * a.x + ny * a.y);
+    addPiece(HalfPlane{nx, ny, -(nx * a.x + ny * a.y) + onEdge * std::hypot(nx, ny)});
   }
   // No outline (degenerate): one half-plane nothing satisfies, so the whole viewport goes black.
-  GLint count = static_cast<GLint>(n);
-  if (n == 0) {
-    g.edgeValues[0] = 0, g.edgeValues[1] = 0, g.edgeValues[2] = -1;
-    count = 1;
-  }
+  if (n == 0) addPiece(HalfPlane{0, 0, -1});
+  if (floats == 0) return;  // the outline covers the whole viewport
   glViewport(viewport.x, viewport.y, static_cast<GLsizei>(viewport.width), static_cast<GLsizei>(viewport.height));
   glEnable(GL_SCISSOR_TEST);
   glScissor(viewport.x, viewport.y, static_cast<GLsizei>(viewport.width), static_cast<GLsizei>(viewport.height));
@@ -86,16 +171,17 @@ void BorderMask::draw(std::span<const Vec2> polygon, const Viewport& viewport, c
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
   glDisable(GL_STENCIL_TEST);
+  // Alpha is written (opaque, as the background leaves it) when every colour is: a masked
+  // channel makes a software GL read each pixel back before it writes it.
+  const bool all = colorMask[0] && colorMask[1] && colorMask[2];
   glColorMask(colorMask[0] ? GL_TRUE : GL_FALSE, colorMask[1] ? GL_TRUE : GL_FALSE, colorMask[2] ? GL_TRUE : GL_FALSE,
-              GL_FALSE);
+              all ? GL_TRUE : GL_FALSE);
   glUseProgram(g.program.id());
-  glUniform4f(g.rect, -1, -1, 1, 1);
-  glUniform4f(g.viewportRect, static_cast<float>(viewport.x), static_cast<float>(viewport.y),
-              static_cast<float>(viewport.width), static_cast<float>(viewport.height));
-  glUniform3fv(g.edges, count, g.edgeValues.data());
-  glUniform1i(g.edgeCount, count);
+  glBindBuffer(GL_ARRAY_BUFFER, g.vertices.id());
+  glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(floats * sizeof(float)), g.values.data());
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
   glBindVertexArray(g.vao.id());
-  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(floats / 2));
   glBindVertexArray(0);
   glUseProgram(0);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -134,23 +220,34 @@ Result<void> FacetRenderer::draw(Renderer& renderer, const runtime::Show& show, 
   if (!pass.stereo) {
     ViewPass viewPass;
     viewPass.viewport = vp;
+    viewPass.scissor = outlineBounds(head_.border, vp);
     drawEye(head_, viewPass);
     return {};
   }
   // Thesis §4.4.3: for stereo the viewer position is offset for each eye, along the view's right.
   const std::array<Viewport, 2> eyeViewports = stereoViewports(vp, pass.stereoMode);
+  std::array<bool, 2> shown{};
   for (std::size_t eye = 0; eye < 2; ++eye) {
     runtime::FacetViewInput eyeInput = input;
     const float offset = (eye == 0 ? -0.5f : 0.5f) * pass.eyeSpacing;
     eyeInput.viewer = input.viewer + head_.right * offset;
     auto r = runtime::computeFacetView(*pass.facet, eyeInput, eyes_[eye]);
+    shown[eye] = r && eyes_[eye].visible;
+  }
+  for (std::size_t eye = 0; eye < 2; ++eye) {
     ViewPass viewPass;
     viewPass.viewport = eyeViewports[eye];
+    viewPass.scissor = outlineBounds(eyes_[eye].border, viewPass.viewport);
     if (pass.stereoMode == runtime::StereoMode::kAnaglyph) {
       viewPass.colorMask = eye == 0 ? std::array<bool, 3>{true, false, false} : std::array<bool, 3>{false, true, true};
       viewPass.drawBackground = eye == 0;
+      // The left eye clears the background for both: it covers both eyes' outlines.
+      if (eye == 0 && shown[1]) {
+        viewPass.scissor = shown[0] ? boundsUnion(viewPass.scissor, outlineBounds(eyes_[1].border, vp))
+                                    : Viewport{};
+      }
     }
-    if (!r || !eyes_[eye].visible) {
+    if (!shown[eye]) {
       mask_->draw({}, viewPass.viewport, viewPass.colorMask);
       continue;
     }

@@ -31,6 +31,20 @@ namespace {
 constexpr std::uint64_t kSweepEveryFrames = 600;
 constexpr int kMaxVltmSegments = 32;
 
+/// The part of `viewport` a pass's scissor leaves; an empty scissor leaves all of it.
+Viewport scissorRect(const Viewport& viewport, const Viewport& scissor) {
+  if (scissor.width == 0 || scissor.height == 0) return viewport;
+  const std::int64_t x0 = std::max<std::int64_t>(viewport.x, scissor.x);
+  const std::int64_t y0 = std::max<std::int64_t>(viewport.y, scissor.y);
+  const std::int64_t x1 = std::min<std::int64_t>(std::int64_t{viewport.x} + viewport.width,
+                                                 std::int64_t{scissor.x} + scissor.width);
+  const std::int64_t y1 = std::min<std::int64_t>(std::int64_t{viewport.y} + viewport.height,
+                                                 std::int64_t{scissor.y} + scissor.height);
+  if (x1 <= x0 || y1 <= y0) return {viewport.x, viewport.y, 0, 0};
+  return {static_cast<std::int32_t>(x0), static_cast<std::int32_t>(y0), static_cast<std::uint32_t>(x1 - x0),
+          static_cast<std::uint32_t>(y1 - y0)};
+}
+
 const void* indexOffset(std::size_t bytes) { return reinterpret_cast<const void*>(bytes); }
 
 std::array<float, 9> normalMatrix(const Mat4& model) {
@@ -862,6 +876,7 @@ struct Renderer::Impl {
     const auto w = static_cast<GLsizei>(viewport.width), h = static_cast<GLsizei>(viewport.height);
     glViewport(viewport.x, viewport.y, w, h);
     glEnable(GL_SCISSOR_TEST);
+    const Viewport clip = scissorRect(viewport, pass.scissor);
     glScissor(viewport.x, viewport.y, w, h);
 
     Mat4 projection = view.projection;
@@ -887,6 +902,7 @@ struct Renderer::Impl {
       glClear(GL_DEPTH_BUFFER_BIT | (self.caps_.stencil ? GL_STENCIL_BUFFER_BIT : 0));
     }
     setColorMask(true);
+    glScissor(clip.x, clip.y, static_cast<GLsizei>(clip.width), static_cast<GLsizei>(clip.height));
     drawFloor(show);
 
     blended.clear();

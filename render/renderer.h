@@ -51,6 +51,9 @@ struct ViewPass {
   /// the anaglyph's left eye writes red only, the right eye green and blue.
   std::array<bool, 3> colorMask{true, true, true};
   Vec2 jitter{0, 0};  ///< sub-pixel offset of the whole view, in pixels (stochastic passes)
+  /// Where in the viewport the view may write, in window pixels (a facet's bounding box: the
+  /// border covers the rest); empty: the whole viewport.
+  Viewport scissor;
 };
 
 /// \brief What the renderer found out about the GL it runs on.

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <GLES3/gl3.h>
+
 #include <cmath>
 
 #include "render/facet_view.h"
@@ -205,6 +207,70 @@ TEST_F(FacetViews, TiledFacetsStayInTheirViewports) {
     const std::uint32_t cx = t * kRenderSize / 2 + kRenderSize / 4;
     EXPECT_FALSE(image->at(cx, kRenderSize / 2, 0) == 0 && image->at(cx, kRenderSize / 2, 2) == 0) << "tile " << t;
   }
+}
+
+TEST_F(FacetViews, TheBorderCoversEveryPixelOutsideAnyOutlineAndNoneInside) {
+  // The border is drawn as the pieces of the viewport outside each edge. Outlines that test
+  // its seams: a 64-gon (the most corners a facet may have), a triangle reaching past the
+  // viewport, a sliver, both windings, and a pixel-centred edge that must stay the facet's.
+  auto mask = render::BorderMask::create();
+  ASSERT_TRUE(mask) << mask.error().describe();
+  std::vector<std::pair<std::string, std::vector<Vec2>>> outlines;
+  std::vector<Vec2> circle;
+  for (int i = 0; i < 64; ++i) {
+    const float a = static_cast<float>(i) * 2.0f * 3.14159265f / 64.0f;
+    circle.push_back({0.9f * std::cos(a), 0.9f * std::sin(a)});
+  }
+  outlines.emplace_back("64-gon", circle);
+  outlines.emplace_back("64-gon clockwise", std::vector<Vec2>(circle.rbegin(), circle.rend()));
+  outlines.emplace_back("triangle past the viewport", std::vector<Vec2>{{-1.5f, -0.8f}, {1.4f, -0.3f}, {0.1f, 1.6f}});
+  outlines.emplace_back("sliver", std::vector<Vec2>{{-0.9f, -0.05f}, {0.9f, -0.02f}, {0.9f, 0.04f}});
+  for (const auto& [what, outline] : outlines) {
+    ASSERT_TRUE(output().beginFrame());
+    glClearColor(0.3f, 0.4f, 0.5f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    (*mask)->draw(outline, {0, 0, kRenderSize, kRenderSize});
+    Image image;
+    ASSERT_TRUE(output().readBack(image));
+    // A quarter pixel either side of the outline may go either way.
+    int inside = 0, outside = 0, wrong = 0;
+    const float margin = 0.25f * 2.0f / static_cast<float>(kRenderSize);
+    for (std::uint32_t y = 0; y < kRenderSize; ++y) {
+      for (std::uint32_t x = 0; x < kRenderSize; ++x) {
+        const Vec2 ndc{(static_cast<float>(x) + 0.5f) / kRenderSize * 2 - 1,
+                       1 - (static_cast<float>(y) + 0.5f) / kRenderSize * 2};
+        const int side = sideOf(outline, ndc, margin);
+        const bool black = image.at(x, y, 0) == 0 && image.at(x, y, 1) == 0 && image.at(x, y, 2) == 0;
+        if (side > 0) ++inside, wrong += black ? 1 : 0;
+        if (side < 0) ++outside, wrong += black ? 0 : 1;
+        EXPECT_EQ(image.at(x, y, 3), 255) << what << " leaves alpha at " << x << "," << y;
+        if (image.at(x, y, 3) != 255) return;
+      }
+    }
+    EXPECT_EQ(wrong, 0) << what << ": " << inside << " pixels inside, " << outside << " outside";
+    EXPECT_GT(inside, 100) << what;
+    EXPECT_GT(outside, 100) << what;
+  }
+  // An edge through a row of pixel centres: that row belongs to the facet, as it did when
+  // every pixel was tested against the outline.
+  const float row = 1 - (100.5f / kRenderSize) * 2;  // centre of image row 100
+  ASSERT_TRUE(output().beginFrame());
+  glClearColor(0.3f, 0.4f, 0.5f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  (*mask)->draw(std::vector<Vec2>{{-0.5f, -0.5f}, {0.5f, -0.5f}, {0.5f, row}, {-0.5f, row}},
+                {0, 0, kRenderSize, kRenderSize});
+  Image image;
+  ASSERT_TRUE(output().readBack(image));
+  EXPECT_NE(image.at(kRenderSize / 2, 100, 2), 0) << "the row on the edge";
+  EXPECT_EQ(image.at(kRenderSize / 2, 99, 2), 0) << "the row above it";
+  // No outline: the whole viewport.
+  ASSERT_TRUE(output().beginFrame());
+  glClearColor(0.3f, 0.4f, 0.5f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  (*mask)->draw({}, {0, 0, kRenderSize, kRenderSize});
+  ASSERT_TRUE(output().readBack(image));
+  EXPECT_EQ(image.at(3, 3, 2), 0);
+  EXPECT_EQ(image.at(kRenderSize / 2, kRenderSize / 2, 2), 0);
 }
 
 }  // namespace
