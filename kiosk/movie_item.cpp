@@ -57,9 +57,15 @@ class MovieItem final : public ItemPlayer {
     }
     if (player_->state() == media::MovieState::kFailed) return std::unexpected(failure());
     player_->setRepeat(playback_.loop);
-    const Nanos duration = player_->info().duration;
-    if (duration > Nanos{0} && position >= duration) position = playback_.loop ? position % duration : Nanos{0};
-    if (started_ || position > Nanos{0}) player_->seekTime(position);
+    if (playback_.timelineStart && placeOnTimeline(position)) {
+      // Nothing from an earlier turn, and never the clip's first frame: the screen stays black
+      // until the frame due on the group's timeline is there.
+      texture_->showFallback();
+    } else {
+      const Nanos duration = player_->info().duration;
+      if (duration > Nanos{0} && position >= duration) position = playback_.loop ? position % duration : Nanos{0};
+      if (started_ || position > Nanos{0}) player_->seekTime(position);
+    }
     player_->play();
     started_ = true;
     ended_ = false;
@@ -73,8 +79,20 @@ class MovieItem final : public ItemPlayer {
       if (frame.time >= *endsAt_) ended_ = true;
       return {};
     }
-    if (playback_.manualClock) player_->waitForFrameDue(frame.time, kFrameTimeout);
-    const FrameRef f = player_->frameAt(frame.time);
+    // Offline runs wait for the frame due; so does a frame-locked node on the system clock,
+    // bounded, so that it draws the frame the others draw.
+    const std::chrono::milliseconds patience =
+        playback_.manualClock     ? std::chrono::duration_cast<std::chrono::milliseconds>(kFrameTimeout)
+        : playback_.timelineStart ? playback_.patience
+                                  : std::chrono::milliseconds(0);
+    if (patience.count() > 0) player_->waitForFrameDue(frame.time, patience);
+    FrameRef f = player_->frameAt(frame.time);
+    if (f && playback_.timelineStart && patience.count() > 0) {
+      // The frame a seek onto the timeline brought was due when the item started; a node that
+      // waited for it takes the frame due now as well, as the others do in this frame.
+      player_->waitForFrameDue(frame.time, patience);
+      if (FrameRef newer = player_->frameAt(frame.time)) f = std::move(newer);
+    }
     const media::MovieState state = player_->state();
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) return std::unexpected(failure());
     auto changed = texture_->update(f);
@@ -100,7 +118,40 @@ class MovieItem final : public ItemPlayer {
 
   [[nodiscard]] bool ended() const override { return ended_; }
 
+  [[nodiscard]] std::int64_t shownFrame() const override {
+    return texture_ && !texture_->showingFallback() ? player_->currentFrame() : -1;
+  }
+
  private:
+  /// Frame-locked: seeks to the frame due `position` after the item's start on the group's
+  /// timeline, due at the show time it belongs to (not when the seek lands), so that every
+  /// later frame and loop falls where it falls on the other nodes. A loop's pass is the
+  /// player's own once it has looped, else the clip's frames x their duration. False when the
+  /// clip's frame rate is unknown (then it plays from its own start).
+  bool placeOnTimeline(Nanos position) {
+    const Nanos frame = player_->info().frameDuration;
+    if (frame <= Nanos{0}) return false;
+    const Nanos elapsed = std::max(Nanos{0}, position);
+    const std::int64_t count = player_->frameCount();
+    Nanos passStart{0};
+    if (playback_.loop) {
+      const Nanos pass = player_->passDuration() > Nanos{0} ? player_->passDuration()
+                         : count > 0                        ? frame * count
+                                                            : Nanos{0};
+      if (pass > Nanos{0}) passStart = (elapsed / pass) * pass;
+    }
+    // As for a movie stream (kiosk/stream_factories.cpp): timestamps sit up to half a
+    // millisecond off the frame grid, so take the frame before when in doubt; the next update
+    // takes the next one if it is due.
+    std::int64_t index = std::max<std::int64_t>(0, (elapsed - passStart + std::chrono::microseconds(1000)) / frame);
+    if (count > 0) index = std::min(index, count - 1);
+    const Nanos timeline = passStart + frame * index;
+    player_->seekFrameDueAt(index, *playback_.timelineStart + timeline, timeline);
+    log::debug(kLogMovieItems, "{}: movie {} joins the group's timeline {:.3f} s into the item: frame {}", where_,
+               entry_.text, toSeconds(position), index);
+    return true;
+  }
+
   [[nodiscard]] Error failure() const {
     const auto error = player_->error();
     return atEntry(error ? *error : Error(Errc::kIo, "the movie stopped", entry_.path.string()), where_);

@@ -575,9 +575,7 @@ void ShowDirector::applyProgramme(Nanos now) {
                                                                  : Error(Errc::kInternal, "item was not prepared"));
       } else {
         found->second->useTextures(context_.renderer.textures());
-        // An item with a duration loops until it is up; so does the only item of its list. One
-        // without, in a list of several, plays once and the list moves on at its end.
-        found->second->setPlayback({p.item->duration > Nanos{0} || p.count <= 1, context_.clock.isManual()});
+        found->second->setPlayback(playbackFor(p));
         started = found->second->start(context_.show, now - p.itemStart, context_.fps);
       }
       if (!started) {
@@ -653,8 +651,14 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
     }
   }
   updateStreams(now);
-  // Which movie frame each texture shows in which frame (BASALT_LOG=kiosk=debug): frame-locked
-  // nodes are compared with it.
+  // Which movie frame the item and each texture show in which frame (BASALT_LOG=kiosk=debug):
+  // frame-locked nodes are compared with it.
+  if (player_ && policy_->current().item) {
+    if (const std::int64_t shown = player_->shownFrame(); shown >= 0) {
+      log::debug(kLogDirector, "frame {}: item '{}' shows movie frame {}", frame.frame, policy_->current().item->name,
+                 shown);
+    }
+  }
   for (const LoadedTexture& t : show_->textures) {
     if (!t.stream) continue;
     if (const std::int64_t shown = t.stream->shownFrame(); shown >= 0) {
@@ -671,6 +675,27 @@ void ShowDirector::setLocked(bool leader, std::chrono::milliseconds patience) {
   follower_ = !leader;
   patience_ = patience;
   if (show_) alignStreams();
+  // A leader's movie item that started with the show (before the lock) starts again on the
+  // group's timeline, from the item's start: the followers place theirs there.
+  const Programme* p = policy_ ? &policy_->current() : nullptr;
+  if (leader && player_ && p && p->item && p->item->entry.kind == EntryKind::kMovie) {
+    player_->setPlayback(playbackFor(*p));
+    if (auto r = player_->start(context_.show, context_.clock.now() - p->itemStart, context_.fps); !r) {
+      log::error(kLogDirector, "'{}' cannot play on the group's timeline: {}", p->item->name, r.error().describe());
+    }
+  }
+}
+
+ItemPlayer::Playback ShowDirector::playbackFor(const Programme& p) const {
+  ItemPlayer::Playback playback;
+  // An item with a duration loops until it is up; so does the only item of its list. One
+  // without, in a list of several, plays once and the list moves on at its end.
+  playback.loop = (p.item && p.item->duration > Nanos{0}) || p.count <= 1;
+  playback.manualClock = context_.clock.isManual();
+  // Frame-locked, a movie's frames fall on the group's timeline from the item's start.
+  if (locked_) playback.timelineStart = p.itemStart;
+  playback.patience = patience_;
+  return playback;
 }
 
 void ShowDirector::alignStreams() {

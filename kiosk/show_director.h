@@ -126,6 +126,8 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   void releaseItemTextures(const std::string& nextKey);
   /// Frame-locked: puts every movie stream of the show on the timeline from mediaStart_.
   void alignStreams();
+  /// How the item `p` plays: looped or once, exact offline, on the group's timeline when locked.
+  [[nodiscard]] ItemPlayer::Playback playbackFor(const Programme& p) const;
 
   DirectorContext context_;
   DisplayViews* views_ = nullptr;

@@ -10,9 +10,11 @@
 /// such an item fails with a message that says so, and the kiosk moves on (DESIGN.md §8: the
 /// show goes on).
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -58,8 +60,16 @@ class ItemPlayer {
   struct Playback {
     bool loop = false;         ///< play on from the start at the end (gapless) instead of ending
     bool manualClock = false;  ///< the show runs on a ManualClock: wait for decoders, frames are exact
+    /// Frame-locked nodes: the show time the item started (its frame 0), on the group's clock. A
+    /// movie's frames then fall on that timeline on every node, whenever its decoder starts.
+    std::optional<Nanos> timelineStart;
+    /// Frame-locked nodes on the system clock: how long a frame may wait for the one due.
+    std::chrono::milliseconds patience{0};
   };
   virtual void setPlayback(const Playback& playback) { (void)playback; }
+  /// \brief The movie frame on screen (a movie item's number in its clip), or -1: frame-locked
+  /// nodes are compared with it.
+  [[nodiscard]] virtual std::int64_t shownFrame() const { return -1; }
 };
 
 /// \brief Makes the player of an entry. Called off the frame loop's thread.

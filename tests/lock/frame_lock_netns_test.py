@@ -17,8 +17,9 @@ node's summary line ("frame lock: ...") to check that all of them drew the same 
                                             with a bounded skew; skew and clock offset printed
 
 With a third argument, the basalt_numbered_clip tool, steady and rejoin also play a movie on
-every node (a [media.loop] movie of numbered frames shown by a [textures.screen]); each node logs
-which movie frame it drew for each locked frame (BASALT_LOG=kiosk=debug), and every node must have
+every node, twice: a [media.loop] movie of numbered frames shown by a [textures.screen], and the
+same clip as the playlist's one item (full screen, looping); each node logs which movie frame the
+texture and the item drew for each locked frame (BASALT_LOG=kiosk=debug), and every node must have
 drawn the same movie frame for every locked frame it drew, the leader the frame the show time
 gives (a 30 fps clip in a 60 fps show: frame N shows movie frame N // 2 modulo the clip's length),
 the restarted follower included.
@@ -42,7 +43,10 @@ PREFIX = f"bl{os.getpid() % 100000}"
 LEADER, NODE_A, NODE_B = f"{PREFIX}l", f"{PREFIX}a", f"{PREFIX}b"
 PORT = 5760
 CLIP_FRAMES = 30  # 1 s at 30 fps: the runs loop it many times (a restarted follower joins after several loops)
-MOVIE_LINE = re.compile(r"frame (\d+): texture 'screen' shows movie 'loop' frame (\d+)")
+MOVIE_LINES = {
+    "texture": re.compile(r"frame (\d+): texture 'screen' shows movie 'loop' frame (\d+)"),
+    "item": re.compile(r"frame (\d+): item 'numbers' shows movie frame (\d+)"),
+}
 
 
 def sh(*args, check=True):
@@ -109,8 +113,11 @@ def write_show(folder, lock, clip=None):
     movie = ""
     if clip:
         shutil.copy(clip, os.path.join(folder, "loop.mkv"))
+        # The clip twice: as a looping [media] stream on a texture, and as the playlist's one
+        # item (full screen, looping while it is alone in its list).
         movie = ('[media.loop]\nkind = "movie"\nfile = "loop.mkv"\nloop = true\n\n'
-                 '[textures.screen]\nsource = "loop"\n\n')
+                 '[textures.screen]\nsource = "loop"\n\n'
+                 '[[kiosk.playlist]]\nname = "numbers"\nentry = "loop.mkv"\n\n')
     with open(os.path.join(folder, "show.toml"), "w") as f:
         f.write('[show]\nname = "frame lock test"\nfps = 60\n\n[output]\nkind = "headless"\n\n' + movie +
                 '[lock]\n' + lock)
@@ -128,15 +135,20 @@ def make_clip(tool, work):
     return path
 
 
-def movie_frames(log):
-    """{locked frame: movie frame} from a node's debug log."""
-    return {int(n): int(k) for n, k in MOVIE_LINE.findall(open(log).read())}
+def movie_frames(log, kind):
+    """{locked frame: movie frame} from a node's debug log, for the texture's or the item's movie."""
+    return {int(n): int(k) for n, k in MOVIE_LINES[kind].findall(open(log).read())}
 
 
 def check_movies(label, leader_log, follower_logs, paced):
+    for kind in MOVIE_LINES:
+        check_movie(f"{label}, {kind}", kind, leader_log, follower_logs, paced)
+
+
+def check_movie(label, kind, leader_log, follower_logs, paced):
     """Every node drew the same movie frame for every locked frame it drew; the leader played the
     clip smoothly (checked on the manual clock; a paced run may hold a frame while decoding)."""
-    lead = movie_frames(leader_log)
+    lead = movie_frames(leader_log, kind)
     assert lead, f"the leader logged no movie frame:\n{open(leader_log).read()[-3000:]}"
     if not paced:
         # The leader plays the clip smoothly on its show clock: a 30 fps clip in a 60 fps show
@@ -153,7 +165,7 @@ def check_movies(label, leader_log, follower_logs, paced):
             longest = max(longest, runs)
         assert longest <= 3, f"the leader showed one movie frame for {longest} show frames"
     for name, log in follower_logs:
-        mine = movie_frames(log)
+        mine = movie_frames(log, kind)
         assert mine, f"{name} logged no movie frame:\n{open(log).read()[-3000:]}"
         common = sorted(set(mine) & set(lead))
         assert len(common) >= len(mine) * 0.95, f"{name}: {len(common)} of {len(mine)} frames also on the leader"
