@@ -93,23 +93,34 @@ class FacetViews : public RenderTest {
   std::unique_ptr<render::FacetRenderer> facets_;
 };
 
-// Every pixel more than 1.5 pixels outside the outline is black; every pixel more than 1.5
-// pixels inside is not (the grey background or the cube).
-void expectBorder(const Image& image, const std::vector<Vec2>& outline, const std::string& what) {
-  int inside = 0, outside = 0, wrong = 0;
-  const float margin = 1.5f * 2.0f / static_cast<float>(kRenderSize);
+struct BorderCount {
+  int inside = 0, outside = 0, wrong = 0;  // pixels well inside, well outside, and of those the wrong colour
+  bool opaque = true;                      // alpha 255 everywhere
+};
+
+// Every pixel more than `marginPixels` outside the outline should be black, every pixel more
+// than that inside not (the grey background or the cube).
+BorderCount countBorder(const Image& image, const std::vector<Vec2>& outline, float marginPixels) {
+  BorderCount c;
+  const float margin = marginPixels * 2.0f / static_cast<float>(kRenderSize);
   for (std::uint32_t y = 0; y < kRenderSize; ++y) {
     for (std::uint32_t x = 0; x < kRenderSize; ++x) {
       const Vec2 ndc{(static_cast<float>(x) + 0.5f) / kRenderSize * 2 - 1,
                      1 - (static_cast<float>(y) + 0.5f) / kRenderSize * 2};
       const int side = sideOf(outline, ndc, margin);
       const bool black = image.at(x, y, 0) == 0 && image.at(x, y, 1) == 0 && image.at(x, y, 2) == 0;
-      if (side > 0) ++inside, wrong += black ? 1 : 0;
-      if (side < 0) ++outside, wrong += black ? 0 : 1;
+      if (side > 0) ++c.inside, c.wrong += black ? 1 : 0;
+      if (side < 0) ++c.outside, c.wrong += black ? 0 : 1;
+      c.opaque = c.opaque && image.at(x, y, 3) == 255;
     }
   }
-  EXPECT_EQ(wrong, 0) << what << ": " << inside << " pixels inside, " << outside << " outside";
-  EXPECT_GT(inside, 1000) << what;
+  return c;
+}
+
+void expectBorder(const Image& image, const std::vector<Vec2>& outline, const std::string& what) {
+  const BorderCount c = countBorder(image, outline, 1.5f);
+  EXPECT_EQ(c.wrong, 0) << what << ": " << c.inside << " pixels inside, " << c.outside << " outside";
+  EXPECT_GT(c.inside, 1000) << what;
 }
 
 TEST_F(FacetViews, EverythingOutsideTheFacetIsBlackForEveryThesisShape) {
@@ -233,23 +244,11 @@ TEST_F(FacetViews, TheBorderCoversEveryPixelOutsideAnyOutlineAndNoneInside) {
     Image image;
     ASSERT_TRUE(output().readBack(image));
     // A quarter pixel either side of the outline may go either way.
-    int inside = 0, outside = 0, wrong = 0;
-    const float margin = 0.25f * 2.0f / static_cast<float>(kRenderSize);
-    for (std::uint32_t y = 0; y < kRenderSize; ++y) {
-      for (std::uint32_t x = 0; x < kRenderSize; ++x) {
-        const Vec2 ndc{(static_cast<float>(x) + 0.5f) / kRenderSize * 2 - 1,
-                       1 - (static_cast<float>(y) + 0.5f) / kRenderSize * 2};
-        const int side = sideOf(outline, ndc, margin);
-        const bool black = image.at(x, y, 0) == 0 && image.at(x, y, 1) == 0 && image.at(x, y, 2) == 0;
-        if (side > 0) ++inside, wrong += black ? 1 : 0;
-        if (side < 0) ++outside, wrong += black ? 0 : 1;
-        EXPECT_EQ(image.at(x, y, 3), 255) << what << " leaves alpha at " << x << "," << y;
-        if (image.at(x, y, 3) != 255) return;
-      }
-    }
-    EXPECT_EQ(wrong, 0) << what << ": " << inside << " pixels inside, " << outside << " outside";
-    EXPECT_GT(inside, 100) << what;
-    EXPECT_GT(outside, 100) << what;
+    const BorderCount c = countBorder(image, outline, 0.25f);
+    EXPECT_EQ(c.wrong, 0) << what << ": " << c.inside << " pixels inside, " << c.outside << " outside";
+    EXPECT_GT(c.inside, 100) << what;
+    EXPECT_GT(c.outside, 100) << what;
+    EXPECT_TRUE(c.opaque) << what << " leaves alpha below 255";
   }
   // An edge through a row of pixel centres: that row belongs to the facet, as it did when
   // every pixel was tested against the outline.
