@@ -294,7 +294,9 @@ struct FrameLock::Impl {
           break;
         case LockMessageKind::kBye: byeSeen = true; break;
         case LockMessageKind::kReady:
-          ++figures.malformed;  // followers do not talk to each other
+        case LockMessageKind::kResend:
+        case LockMessageKind::kCommand:
+          ++figures.malformed;  // followers do not talk to each other; commands come on DEALER
           break;
       }
     }

@@ -16,7 +16,7 @@ static_assert(std::endian::native == std::endian::little, "the frame-lock encodi
 namespace {
 
 constexpr std::array<char, 4> kMagic{'B', 'L', 'C', 'K'};
-constexpr std::uint8_t kVersion = 2;
+constexpr std::uint8_t kVersion = 3;
 
 class Writer {
  public:
@@ -45,6 +45,13 @@ class Writer {
   void bytes(const char* data, std::size_t n) {
     std::memcpy(out_.data() + at_, data, n);
     at_ += n;
+  }
+  /// `text` (at most `field` bytes), NUL-padded to `field`.
+  void padded(std::string_view text, std::size_t field) {
+    const std::size_t n = std::min(text.size(), field);
+    std::memcpy(out_.data() + at_, text.data(), n);
+    std::memset(out_.data() + at_ + n, 0, field - n);
+    at_ += field;
   }
   [[nodiscard]] std::size_t size() const { return at_; }
 
@@ -82,6 +89,16 @@ class Reader {
     std::memcpy(data, in_.data() + at_, n);
     at_ += n;
   }
+  /// A text of `length` bytes in a NUL-padded field of `field`: false when the length is beyond
+  /// the field, the padding is not zero or the text holds a NUL or a line break.
+  bool padded(std::size_t length, std::size_t field, std::string& text) {
+    const auto* begin = reinterpret_cast<const char*>(in_.data() + at_);
+    at_ += field;
+    if (length > field) return false;
+    text.assign(begin, length);
+    if (std::any_of(begin + length, begin + field, [](char c) { return c != '\0'; })) return false;
+    return text.find_first_of(std::string_view("\0\n\r", 3)) == std::string::npos;
+  }
   [[nodiscard]] bool finite() const { return finite_; }
 
  private:
@@ -96,6 +113,8 @@ std::string_view kindName(LockMessageKind kind) {
     case LockMessageKind::kPresent: return "present";
     case LockMessageKind::kReady: return "ready";
     case LockMessageKind::kBye: return "bye";
+    case LockMessageKind::kResend: return "resend";
+    case LockMessageKind::kCommand: return "command";
   }
   return "unknown";
 }
@@ -106,6 +125,8 @@ std::size_t sizeOf(LockMessageKind kind) {
     case LockMessageKind::kPresent: return kPresentMessageBytes;
     case LockMessageKind::kReady: return kReadyMessageBytes;
     case LockMessageKind::kBye: return kByeMessageBytes;
+    case LockMessageKind::kResend: return kResendMessageBytes;
+    case LockMessageKind::kCommand: return kCommandMessageBytes;
   }
   return 0;
 }
@@ -228,6 +249,15 @@ std::size_t encode(const FrameMessage& m, LockBuffer& out) {
   w.put(std::uint32_t{0});
   w.bytes(p.item.data(), p.item.size());
   for (const std::int64_t pass : p.moviePassNs) w.put(pass);
+  const LockedCommand& c = m.command;
+  const bool carried = c.carried && c.text.size() <= kFrameCommandBytes;
+  w.put(c.epoch);
+  w.put(c.newest);
+  w.put(c.base);
+  w.put(static_cast<std::uint16_t>(carried ? c.text.size() : 0));
+  w.put(static_cast<std::uint8_t>(carried ? 1U : 0U));
+  w.put(std::uint8_t{0});
+  w.padded(carried ? std::string_view(c.text) : std::string_view(), kFrameCommandBytes);
   return w.size();
 }
 
@@ -252,6 +282,26 @@ std::size_t encode(const ByeMessage& m, LockBuffer& out) {
   Writer w(out);
   w.header(LockMessageKind::kBye);
   w.put(m.frame);
+  return w.size();
+}
+
+std::size_t encode(const ResendMessage& m, LockBuffer& out) {
+  Writer w(out);
+  w.header(LockMessageKind::kResend);
+  w.put(m.epoch);
+  w.put(m.from);
+  return w.size();
+}
+
+std::size_t encode(const CommandMessage& m, LockBuffer& out) {
+  Writer w(out);
+  w.header(LockMessageKind::kCommand);
+  w.put(m.epoch);
+  w.put(m.seq);
+  w.put(static_cast<std::uint16_t>(std::min(m.text.size(), kCommandTextBytes)));
+  w.put(static_cast<std::uint8_t>(m.earlierGone ? 1U : 0U));
+  w.put(std::uint8_t{0});
+  w.padded(m.text, kCommandTextBytes);
   return w.size();
 }
 
@@ -334,6 +384,26 @@ Result<FrameMessage> decodeFrame(std::span<const std::byte> bytes) {
   }
   p.present = (programmeFlags & 1U) != 0;
   p.hasItem = (programmeFlags & 2U) != 0;
+  LockedCommand& c = m.command;
+  c.epoch = r.get<std::uint32_t>();
+  c.newest = r.get<std::uint32_t>();
+  c.base = r.get<std::uint32_t>();
+  const auto length = r.get<std::uint16_t>();
+  const auto commandFlags = r.get<std::uint8_t>();
+  const auto reserved3 = r.get<std::uint8_t>();
+  const bool textOk = r.padded(length, kFrameCommandBytes, c.text);
+  if (commandFlags > 1 || reserved3 != 0) {
+    return fail(Errc::kParse, "frame-lock message: the 'frame' message's command flags or reserved byte are unknown");
+  }
+  c.carried = commandFlags == 1;
+  if (!textOk || (c.carried ? (length == 0 || c.newest == 0) : length != 0)) {
+    return fail(Errc::kParse,
+                "frame-lock message: the 'frame' message's command text is too long, not one line, not padded with "
+                "zeros, or does not match its flag");
+  }
+  if (c.base > c.newest) {
+    return failf(Errc::kParse, "frame-lock message: command base {} is beyond the newest command {}", c.base, c.newest);
+  }
   if (auto f = finiteOrFail(r, LockMessageKind::kFrame); !f) return std::unexpected(f.error());
   if (m.frame < 0) return failf(Errc::kParse, "frame-lock message: frame number {} is negative", m.frame);
   return m;
@@ -367,6 +437,57 @@ Result<ByeMessage> decodeBye(std::span<const std::byte> bytes) {
   ByeMessage m;
   m.frame = r.get<std::int64_t>();
   return m;
+}
+
+Result<ResendMessage> decodeResend(std::span<const std::byte> bytes) {
+  if (auto r = expectKind(bytes, LockMessageKind::kResend); !r) return std::unexpected(r.error());
+  Reader r(bytes);
+  ResendMessage m;
+  m.epoch = r.get<std::uint32_t>();
+  m.from = r.get<std::uint32_t>();
+  if (m.from == 0) return fail(Errc::kParse, "frame-lock message: a 'resend' from command 0 (commands count from 1)");
+  return m;
+}
+
+Result<CommandMessage> decodeCommand(std::span<const std::byte> bytes) {
+  if (auto r = expectKind(bytes, LockMessageKind::kCommand); !r) return std::unexpected(r.error());
+  Reader r(bytes);
+  CommandMessage m;
+  m.epoch = r.get<std::uint32_t>();
+  m.seq = r.get<std::uint32_t>();
+  const auto length = r.get<std::uint16_t>();
+  const auto flags = r.get<std::uint8_t>();
+  const auto reserved = r.get<std::uint8_t>();
+  const bool textOk = r.padded(length, kCommandTextBytes, m.text);
+  if (flags > 1 || reserved != 0) {
+    return fail(Errc::kParse, "frame-lock message: the 'command' message's flags or reserved byte are unknown");
+  }
+  m.earlierGone = flags == 1;
+  if (m.seq == 0) return fail(Errc::kParse, "frame-lock message: command number 0 (commands count from 1)");
+  if (!textOk || length == 0) {
+    return fail(Errc::kParse,
+                "frame-lock message: the 'command' message's text is empty, too long, not one line or not padded "
+                "with zeros");
+  }
+  return m;
+}
+
+void LockCommandLog::restart(std::uint32_t epoch) {
+  epoch_ = epoch;
+  newest_ = 0;
+  base_ = 0;
+  kept_.clear();
+}
+
+std::uint32_t LockCommandLog::add(std::string text) {
+  kept_.push_back(std::move(text));
+  if (kept_.size() > kKept) kept_.pop_front();
+  return ++newest_;
+}
+
+const std::string* LockCommandLog::at(std::uint32_t seq) const {
+  if (seq == 0 || seq > newest_ || seq < oldest()) return nullptr;
+  return &kept_[kept_.size() - 1 - (newest_ - seq)];
 }
 
 }  // namespace basalt::kiosk

@@ -5,15 +5,19 @@
 /// sends each frame, and what the followers answer. Plain encoding and decoding, no sockets:
 /// `kiosk/frame_lock.cpp` carries the bytes over ZeroMQ, and every message is one ZeroMQ frame.
 ///
-/// Layout: every message starts with the 4 bytes "BLCK", a version byte (2), a kind byte and
+/// Layout: every message starts with the 4 bytes "BLCK", a version byte (3), a kind byte and
 /// two bytes of zero, then the kind's fixed fields, little-endian (integers two's complement,
 /// floats IEEE 754). The size of each kind is fixed; a message of another size, another magic or
 /// version, an unknown kind or a non-finite number is rejected with the reason. Version 2 added
-/// the director's programme (LockedProgramme) to the `frame` message.
+/// the director's programme (LockedProgramme) to the `frame` message; version 3 the leader's
+/// script commands (LockedCommand in `frame`, and the `resend` and `command` kinds that bring a
+/// follower the commands it missed).
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <span>
 #include <string>
 
@@ -78,11 +82,32 @@ struct LockedProgramme {
   void setItemName(std::string_view name);
 };
 
+/// The longest command text a `frame` message carries; a longer one comes by `command` message.
+constexpr std::size_t kFrameCommandBytes = 200;
+/// The longest script command a frame-locked leader runs (what a `command` message carries).
+constexpr std::size_t kCommandTextBytes = 1024;
+
+/// \brief The leader's script commands as a frame announces them (thesis §4.5: a control
+/// request's command acts on every node). The leader numbers the commands it ran since its show
+/// was (re)loaded from 1; a follower runs them in that order.
+struct LockedCommand {
+  std::uint32_t epoch = 0;   ///< the leader's reload count: its log starts again with each reload
+  std::uint32_t newest = 0;  ///< the newest command's number (0: none since the show loaded)
+  /// Commands up to this number no longer act: the leader's show was reset after them (an item
+  /// switch starts the item's own Show), so a follower catching up skips them.
+  std::uint32_t base = 0;
+  bool carried = false;  ///< `text` is command `newest`, new in this frame
+  std::string text;      ///< at most kFrameCommandBytes, one line
+  friend bool operator==(const LockedCommand&, const LockedCommand&) = default;
+};
+
 enum class LockMessageKind : std::uint8_t {
   kFrame = 1,    ///< leader -> all: draw frame N with this state
   kPresent = 2,  ///< leader -> all: present frame N now
   kReady = 3,    ///< follower -> leader: frame N is drawn (or -1: I am here, send me frames)
   kBye = 4,      ///< leader -> all: the leader is ending the show
+  kResend = 5,   ///< follower -> leader: send me your commands from number N on
+  kCommand = 6,  ///< leader -> one follower: command N of the log
 };
 
 /// \brief Leader -> followers, published before the leader draws the frame.
@@ -92,6 +117,7 @@ struct FrameMessage {
   std::int64_t sentNs = 0;      ///< when the leader sent it, on the shared clock (delay figures)
   LockedShowState state;
   LockedProgramme programme;
+  LockedCommand command;  ///< since version 3
   friend bool operator==(const FrameMessage&, const FrameMessage&) = default;
 };
 
@@ -118,6 +144,24 @@ struct ByeMessage {
   friend bool operator==(const ByeMessage&, const ByeMessage&) = default;
 };
 
+/// \brief Follower -> leader (DEALER -> ROUTER): the commands of log `epoch` from `from` on.
+struct ResendMessage {
+  std::uint32_t epoch = 0;
+  std::uint32_t from = 1;
+  friend bool operator==(const ResendMessage&, const ResendMessage&) = default;
+};
+
+/// \brief Leader -> the follower that asked (ROUTER -> DEALER): command `seq` of log `epoch`.
+struct CommandMessage {
+  std::uint32_t epoch = 0;
+  std::uint32_t seq = 1;
+  /// The commands before `seq` that the follower asked for are gone from the leader's log (it
+  /// keeps the newest LockCommandLog::kKept).
+  bool earlierGone = false;
+  std::string text;  ///< 1 to kCommandTextBytes bytes, one line
+  friend bool operator==(const CommandMessage&, const CommandMessage&) = default;
+};
+
 constexpr std::size_t kLockHeaderBytes = 8;
 /// Three matrices, two rotations, two scales, the motion flags and frame count, the view's
 /// centre and three numbers, the viewer's position and rotation, the eye spacing.
@@ -125,11 +169,18 @@ constexpr std::size_t kLockedStateBytes = 284;
 /// Flags, mode, display, a reserved byte, the index, two times, the reload count, four reserved
 /// bytes, the item's name and four movie passes.
 constexpr std::size_t kLockedProgrammeBytes = 96;
-constexpr std::size_t kFrameMessageBytes = kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes;
+/// The epoch, the newest and base numbers, the text's length, flags, a reserved byte and the
+/// text, NUL-padded.
+constexpr std::size_t kLockedCommandBytes = 16 + kFrameCommandBytes;
+constexpr std::size_t kFrameMessageBytes =
+    kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes + kLockedCommandBytes;
 constexpr std::size_t kPresentMessageBytes = kLockHeaderBytes + 8;
 constexpr std::size_t kReadyMessageBytes = kLockHeaderBytes + 24 + 32;
 constexpr std::size_t kByeMessageBytes = kLockHeaderBytes + 8;
-constexpr std::size_t kMaxLockMessageBytes = kFrameMessageBytes;
+constexpr std::size_t kResendMessageBytes = kLockHeaderBytes + 8;
+/// The epoch, the number, the text's length, flags, a reserved byte and the text, NUL-padded.
+constexpr std::size_t kCommandMessageBytes = kLockHeaderBytes + 12 + kCommandTextBytes;
+constexpr std::size_t kMaxLockMessageBytes = std::max(kFrameMessageBytes, kCommandMessageBytes);
 
 /// \brief A buffer big enough for any message; encode* return the bytes used.
 using LockBuffer = std::array<std::byte, kMaxLockMessageBytes>;
@@ -138,6 +189,9 @@ std::size_t encode(const FrameMessage& m, LockBuffer& out);
 std::size_t encode(const PresentMessage& m, LockBuffer& out);
 std::size_t encode(const ReadyMessage& m, LockBuffer& out);
 std::size_t encode(const ByeMessage& m, LockBuffer& out);
+std::size_t encode(const ResendMessage& m, LockBuffer& out);
+/// \brief `m.text` must fit kCommandTextBytes (the leader refuses longer commands).
+std::size_t encode(const CommandMessage& m, LockBuffer& out);
 
 /// \brief The kind of a message whose header is valid (magic, version, known kind, the kind's
 /// size), or why it is not.
@@ -146,5 +200,33 @@ Result<FrameMessage> decodeFrame(std::span<const std::byte> bytes);
 Result<PresentMessage> decodePresent(std::span<const std::byte> bytes);
 Result<ReadyMessage> decodeReady(std::span<const std::byte> bytes);
 Result<ByeMessage> decodeBye(std::span<const std::byte> bytes);
+Result<ResendMessage> decodeResend(std::span<const std::byte> bytes);
+Result<CommandMessage> decodeCommand(std::span<const std::byte> bytes);
+
+/// \brief The leader's log of the script commands it ran since its show was (re)loaded,
+/// numbered from 1, the newest kKept of them kept for followers that missed some.
+class LockCommandLog {
+ public:
+  static constexpr std::uint32_t kKept = 1024;
+  /// \brief The show was (re)loaded: numbering starts again at 1 under `epoch`.
+  void restart(std::uint32_t epoch);
+  /// \brief Records a command that ran; returns its number.
+  std::uint32_t add(std::string text);
+  /// \brief The show was reset (an item started): the commands so far no longer act.
+  void markShowReset() { base_ = newest_; }
+  [[nodiscard]] std::uint32_t epoch() const { return epoch_; }
+  [[nodiscard]] std::uint32_t newest() const { return newest_; }
+  [[nodiscard]] std::uint32_t base() const { return base_; }
+  /// \brief The oldest number still kept (newest() + 1 when none is).
+  [[nodiscard]] std::uint32_t oldest() const { return newest_ + 1 - static_cast<std::uint32_t>(kept_.size()); }
+  /// \brief Command `seq`, or null when it is not kept (or not run yet).
+  [[nodiscard]] const std::string* at(std::uint32_t seq) const;
+
+ private:
+  std::uint32_t epoch_ = 0;
+  std::uint32_t newest_ = 0;
+  std::uint32_t base_ = 0;
+  std::deque<std::string> kept_;
+};
 
 }  // namespace basalt::kiosk

@@ -3,11 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <thread>
 #include <vector>
 
@@ -46,6 +49,11 @@ FrameMessage sampleFrame() {
   m.programme.reloads = 2;
   m.programme.setItemName("night sky");
   m.programme.moviePassNs = {3'000'333'333, 0, 0, 0};
+  m.command.epoch = 2;
+  m.command.newest = 5;
+  m.command.base = 3;
+  m.command.carried = true;
+  m.command.text = "render.prim_type = wireframe";
   return m;
 }
 
@@ -83,6 +91,37 @@ TEST(LockProtocol, MessagesRoundTrip) {
   auto bye = decodeBye(bytesOf(b, encode(ByeMessage{99}, b)));
   ASSERT_TRUE(bye);
   EXPECT_EQ(bye->frame, 99);
+
+  // Version 3: a frame that announces a command without its text, the re-send and the command.
+  FrameMessage quiet = sampleFrame();
+  quiet.command.carried = false;
+  quiet.command.text.clear();
+  auto q = decodeFrame(bytesOf(b, encode(quiet, b)));
+  ASSERT_TRUE(q) << q.error().message();
+  EXPECT_EQ(*q, quiet);
+  auto resend = decodeResend(bytesOf(b, encode(ResendMessage{2, 4}, b)));
+  ASSERT_TRUE(resend) << resend.error().message();
+  EXPECT_EQ(*resend, (ResendMessage{2, 4}));
+  CommandMessage command{2, 1030, true, std::string(kCommandTextBytes, 'x')};
+  const std::size_t cn = encode(command, b);
+  EXPECT_EQ(cn, kCommandMessageBytes);
+  auto c = decodeCommand(bytesOf(b, cn));
+  ASSERT_TRUE(c) << c.error().message();
+  EXPECT_EQ(*c, command);
+}
+
+// Makes sure a frame never carries a command text that does not fit its field: it announces the
+// number only, and the follower asks for the text. Example failure: a long command cut short
+// on the followers.
+TEST(LockProtocol, ALongCommandIsAnnouncedWithoutItsText) {
+  LockBuffer b{};
+  FrameMessage m = sampleFrame();
+  m.command.text = std::string(kFrameCommandBytes + 1, 'y');
+  auto back = decodeFrame(bytesOf(b, encode(m, b)));
+  ASSERT_TRUE(back) << back.error().message();
+  EXPECT_FALSE(back->command.carried);
+  EXPECT_EQ(back->command.text, "");
+  EXPECT_EQ(back->command.newest, 5U);
 }
 
 // Makes sure a truncated, lengthened or foreign message is rejected with the reason, never read
@@ -101,7 +140,8 @@ TEST(LockProtocol, MalformedMessagesAreRejectedWithTheReason) {
   std::memcpy(longer.data(), b.data(), n);
   auto tooLong = decodeFrame(longer);
   ASSERT_FALSE(tooLong);
-  EXPECT_NE(tooLong.error().message().find("this one has 413"), std::string::npos) << tooLong.error().message();
+  EXPECT_NE(tooLong.error().message().find(fmt::format("this one has {}", kFrameMessageBytes + 1)), std::string::npos)
+      << tooLong.error().message();
 
   LockBuffer bad = b;
   bad[0] = std::byte{'X'};
@@ -110,10 +150,10 @@ TEST(LockProtocol, MalformedMessagesAreRejectedWithTheReason) {
   EXPECT_NE(magic.error().message().find("magic"), std::string::npos);
 
   bad = b;
-  bad[4] = std::byte{1};  // a basalt from before the programme was sent
+  bad[4] = std::byte{2};  // a basalt from before the commands were sent
   auto version = decodeFrame(bytesOf(bad, n));
   ASSERT_FALSE(version);
-  EXPECT_NE(version.error().message().find("version 1, this basalt speaks version 2"), std::string::npos)
+  EXPECT_NE(version.error().message().find("version 2, this basalt speaks version 3"), std::string::npos)
       << version.error().message();
 
   bad = b;
@@ -157,6 +197,82 @@ TEST(LockProtocol, MalformedMessagesAreRejectedWithTheReason) {
   FrameMessage negative = sampleFrame();
   negative.frame = -3;
   EXPECT_FALSE(decodeFrame(bytesOf(bad, encode(negative, bad))));
+}
+
+// Makes sure the version-3 command fields are checked: unknown flags, reserved bytes, a text
+// longer than its field or not padded with zeros, more than one line, a flag that contradicts
+// the length, a base beyond the newest command; and the resend and command messages' own
+// fields and sizes. Example failure: a corrupt frame that runs a garbage command on a follower.
+TEST(LockProtocol, BadCommandFieldsAreRejectedWithTheReason) {
+  LockBuffer b{};
+  const std::size_t n = encode(sampleFrame(), b);
+  ASSERT_EQ(n, kFrameMessageBytes);
+  constexpr std::size_t kCommandAt = kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes;
+  const auto rejects = [&](std::size_t at, std::byte value, std::string_view why) {
+    LockBuffer bad = b;
+    bad[at] = value;
+    auto d = decodeFrame(bytesOf(bad, n));
+    ASSERT_FALSE(d) << "accepted byte " << at - kCommandAt << " of the command = " << std::to_integer<int>(value);
+    EXPECT_NE(d.error().message().find(why), std::string::npos) << d.error().message();
+  };
+  rejects(kCommandAt + 14, std::byte{2}, "command flags");                  // an unknown flag
+  rejects(kCommandAt + 15, std::byte{1}, "reserved");                       // the reserved byte
+  rejects(kCommandAt + 12, std::byte{kFrameCommandBytes + 1}, "too long");  // length beyond the field
+  rejects(kCommandAt + 13, std::byte{1}, "too long");                       // length beyond the field (high byte)
+  rejects(kCommandAt + 16 + 40, std::byte{'x'}, "padded");                  // text after the length
+  rejects(kCommandAt + 16 + 3, std::byte{'\n'}, "one line");                // two lines
+  rejects(kCommandAt + 12, std::byte{0}, "flag");                           // carried, but empty
+  rejects(kCommandAt + 14, std::byte{0}, "flag");                           // not carried, but a text
+  rejects(kCommandAt + 8, std::byte{9}, "base 9 is beyond the newest command 5");
+
+  // The resend and command messages: truncated or lengthened, and their own fields.
+  for (std::size_t len = 0; len < kResendMessageBytes; ++len) {
+    EXPECT_FALSE(decodeResend(bytesOf(b, encode(ResendMessage{1, 2}, b) - kResendMessageBytes + len))) << len;
+  }
+  auto fromZero = decodeResend(bytesOf(b, encode(ResendMessage{1, 0}, b)));
+  ASSERT_FALSE(fromZero);
+  EXPECT_NE(fromZero.error().message().find("from command 0"), std::string::npos);
+  const std::size_t cn = encode(CommandMessage{1, 7, false, "background 1 0 0"}, b);
+  for (std::size_t len = 0; len < cn; len += 37) EXPECT_FALSE(decodeCommand(bytesOf(b, len))) << len;
+  std::array<std::byte, kCommandMessageBytes + 1> longer{};
+  std::memcpy(longer.data(), b.data(), cn);
+  EXPECT_FALSE(decodeCommand(longer));
+  EXPECT_FALSE(decodeCommand(bytesOf(b, encode(CommandMessage{1, 0, false, "x"}, b))));
+  EXPECT_FALSE(decodeCommand(bytesOf(b, encode(CommandMessage{1, 3, false, ""}, b))));
+  EXPECT_FALSE(decodeCommand(bytesOf(b, encode(CommandMessage{1, 3, false, "a\nb"}, b))));
+  LockBuffer bad{};
+  const std::size_t bn = encode(CommandMessage{1, 3, false, "x"}, bad);
+  bad[kLockHeaderBytes + 10] = std::byte{4};  // an unknown flag
+  auto flags = decodeCommand(bytesOf(bad, bn));
+  ASSERT_FALSE(flags);
+  EXPECT_NE(flags.error().message().find("flags"), std::string::npos);
+  // A command where a frame is expected, and the other way round.
+  EXPECT_FALSE(decodeFrame(bytesOf(b, cn)));
+  EXPECT_FALSE(decodeCommand(bytesOf(b, encode(sampleFrame(), b))));
+}
+
+// Makes sure the leader's log numbers commands from 1, keeps the newest kKept, and starts again
+// with a reload. Example failure: a follower asking for command 3 gets command 4.
+TEST(LockProtocol, TheCommandLogKeepsTheNewestAndStartsAgainWithAReload) {
+  LockCommandLog log;
+  EXPECT_EQ(log.newest(), 0U);
+  EXPECT_EQ(log.at(1), nullptr);
+  for (std::uint32_t i = 1; i <= LockCommandLog::kKept + 76; ++i) EXPECT_EQ(log.add(fmt::format("c{}", i)), i);
+  EXPECT_EQ(log.oldest(), 77U);
+  EXPECT_EQ(log.at(76), nullptr);
+  ASSERT_NE(log.at(77), nullptr);
+  EXPECT_EQ(*log.at(77), "c77");
+  EXPECT_EQ(*log.at(LockCommandLog::kKept + 76), fmt::format("c{}", LockCommandLog::kKept + 76));
+  EXPECT_EQ(log.at(LockCommandLog::kKept + 77), nullptr);
+  log.markShowReset();
+  EXPECT_EQ(log.base(), LockCommandLog::kKept + 76);
+  log.restart(4);
+  EXPECT_EQ(log.epoch(), 4U);
+  EXPECT_EQ(log.newest(), 0U);
+  EXPECT_EQ(log.base(), 0U);
+  EXPECT_EQ(log.oldest(), 1U);
+  EXPECT_EQ(log.add("again"), 1U);
+  EXPECT_EQ(*log.at(1), "again");
 }
 
 // ---- The manifest's [lock] ----
