@@ -112,6 +112,7 @@ struct FrameLock::Impl {
   Samples delay;
   // Leader.
   std::map<std::string, Follower, std::less<>> followers;
+  std::optional<std::pair<std::uint32_t, std::uint32_t>> announced;  // (epoch, newest) of the last frame
   // Follower.
   std::optional<FrameMessage> pending;  // the newest frame received and not drawn yet
   std::int64_t current = -1;            // the frame being drawn
@@ -121,6 +122,15 @@ struct FrameLock::Impl {
   bool joined = false;
   bool waitingReported = false;
   Nanos lastHello{-1};
+  // Follower: the leader's script commands.
+  std::optional<std::uint32_t> commandEpoch;          // the leader's log being followed
+  std::uint32_t lastCommandRun = 0;                   // the last of its commands run on this show
+  std::uint32_t commandsAnnounced = 0;                // the newest the leader announced
+  std::uint32_t commandBase = 0;                      // commands up to here no longer act
+  std::optional<std::uint64_t> commandsForShow;       // the director's showLoads() they were run on
+  std::map<std::uint32_t, std::string> commandsHeld;  // received, not run yet (by number)
+  std::uint32_t resendFrom = 0;                       // the last re-send asked, and when
+  Nanos resendAt{-1};
 
   Impl(const LockSpec& s, const Clock& c, runtime::Show& sh) : spec(s), clock(c), show(sh) {}
 
@@ -159,7 +169,17 @@ struct FrameLock::Impl {
         ++figures.malformed;
       }
       const auto size = std::min<std::size_t>(static_cast<std::size_t>(n), bytes.size());
-      auto ready = decodeReady(std::span<const std::byte>(bytes.data(), size));
+      const std::span<const std::byte> message(bytes.data(), size);
+      if (auto kind = peekKind(message); kind && *kind == LockMessageKind::kResend) {
+        auto resend = decodeResend(message);
+        if (!resend) {
+          if (figures.malformed++ == 0) log::warn(kLogLock, "{}", resend.error().message());
+          continue;
+        }
+        resendCommands(std::string_view(id.data(), std::min(static_cast<std::size_t>(idBytes), id.size())), *resend);
+        continue;
+      }
+      auto ready = decodeReady(message);
       if (!ready) {
         if (figures.malformed++ == 0) log::warn(kLogLock, "{}", ready.error().message());
         continue;
@@ -199,8 +219,62 @@ struct FrameLock::Impl {
       m.programme = director->lockedProgramme();
       m.programme.present = true;
       noteProgramme(m.frame, m.programme, "sends");
+      if (const LockCommandLog* commands = director->commandLog()) announceCommands(*commands, m.command);
     }
     send(pub.get(), encode(m, buffer));
+  }
+
+  /// The frame announces the newest command, with its text when it is new in this frame and
+  /// fits; a follower without it asks for it (resendCommands).
+  void announceCommands(const LockCommandLog& commands, LockedCommand& c) {
+    c.epoch = commands.epoch();
+    c.newest = commands.newest();
+    c.base = commands.base();
+    const std::pair<std::uint32_t, std::uint32_t> now{c.epoch, c.newest};
+    const bool isNew = c.newest > 0 && (!announced || *announced != now);
+    if (announced && announced->first == c.epoch && c.newest > announced->second)
+      figures.commandsApplied += c.newest - announced->second;
+    else if (c.newest > 0 && (!announced || announced->first != c.epoch))
+      figures.commandsApplied += c.newest;
+    announced = now;
+    const std::string* text = isNew ? commands.at(c.newest) : nullptr;
+    if (text && text->size() <= kFrameCommandBytes) {
+      c.carried = true;
+      c.text = *text;
+    }
+  }
+
+  /// Sends the follower `id` the commands it asked for, a batch at a time (it asks again for
+  /// the rest once it has them), directly over ROUTER; never blocks.
+  void resendCommands(std::string_view id, const ResendMessage& ask) {
+    const LockCommandLog* commands = director ? director->commandLog() : nullptr;
+    // Another epoch: the follower asks for a log this leader's reload ended; the next frame
+    // tells it the new one.
+    if (!commands || ask.epoch != commands->epoch() || ask.from > commands->newest()) return;
+    constexpr std::uint32_t kBatch = 64;  // well under the sockets' high-water mark of 256
+    CommandMessage m;
+    m.epoch = commands->epoch();
+    m.seq = ask.from;
+    if (ask.from < commands->oldest()) {
+      log::warn(kLogLock,
+                "follower '{}' asks for command {}, but this leader keeps only its last {} commands (from {} on): "
+                "it misses {}; reload the show on the leader (POST /control/reload) to bring every node to the "
+                "same state",
+                id, ask.from, LockCommandLog::kKept, commands->oldest(), commands->oldest() - ask.from);
+      m.seq = commands->oldest();
+      m.earlierGone = true;
+    }
+    const std::uint32_t last = std::min(commands->newest(), m.seq + kBatch - 1);
+    for (; m.seq <= last; ++m.seq) {
+      const std::string* text = commands->at(m.seq);
+      if (!text) break;
+      m.text = *text;
+      const std::size_t n = encode(m, buffer);
+      if (zmq_send(answers.get(), id.data(), id.size(), ZMQ_SNDMORE | ZMQ_DONTWAIT) < 0) break;
+      (void)zmq_send(answers.get(), buffer.data(), n, ZMQ_DONTWAIT);
+      ++figures.commandsResent;
+      m.earlierGone = false;
+    }
   }
 
   /// Counts and logs a change of programme (item, mode, display, start or media start).
@@ -281,7 +355,10 @@ struct FrameLock::Impl {
           if (auto f = decodeFrame(message)) {
             delay.add(millis(shared->now() - Nanos{f->sentNs}));
             // A newer frame replaces one not drawn yet: nextFrame() counts the gap as skipped.
-            if (f->frame > current && (!pending || f->frame > pending->frame)) pending = *f;
+            if (f->frame > current && (!pending || f->frame > pending->frame)) {
+              if (pending) keepCommand(pending->command);
+              pending = *f;
+            }
           } else {
             ++figures.malformed;
           }
@@ -371,6 +448,13 @@ struct FrameLock::Impl {
           if (director->followProgramme(f.programme, Nanos{f.showTimeNs}))
             noteProgramme(f.frame, f.programme, "follows");
         }
+        // Then the leader's script commands, in order: those it ran in this frame act in it on
+        // every node (after the programme, which may have reset the show, as on the leader).
+        if (director && f.programme.present) {
+          noteCommands(f.command);
+          takeResentCommands();
+          runCommands(f.frame);
+        }
         return GatedFrame{f.frame, Nanos{f.showTimeNs}, false};
       }
       const Nanos left = deadline - wall.now();
@@ -381,6 +465,113 @@ struct FrameLock::Impl {
       (void)zmq_poll(&item, 1, std::min<long>(5, std::max<long>(1, static_cast<long>(left.count() / 1'000'000))));
       if (auto r = loop.dispatch(Nanos{0}); !r) return std::unexpected(r.error());
     }
+  }
+
+  /// What a frame says of the leader's commands: a new log (the leader reloaded), the newest
+  /// number, and the newest's text when it came in this frame.
+  void noteCommands(const LockedCommand& c) {
+    if (!commandEpoch || *commandEpoch != c.epoch) {
+      if (commandEpoch) {
+        log::info(kLogLock, "the leader's command log starts again (its show was reloaded, reload {})", c.epoch);
+      }
+      commandEpoch = c.epoch;
+      lastCommandRun = 0;
+      commandsHeld.clear();
+      resendFrom = 0;
+    } else if (c.newest < lastCommandRun) {
+      log::warn(kLogLock,
+                "the leader's command log starts again at {} though this node ran {} of its commands (a restarted "
+                "leader?); this node's show keeps them: reload the show on the leader (POST /control/reload) to "
+                "bring every node to the same state",
+                c.newest, lastCommandRun);
+      lastCommandRun = 0;
+      commandsHeld.clear();
+      resendFrom = 0;
+    }
+    commandsAnnounced = c.newest;
+    commandBase = c.base;
+    if (c.carried && c.newest > lastCommandRun) commandsHeld.insert_or_assign(c.newest, c.text);
+  }
+
+  /// The command a frame passed over carried, so that it need not be asked for again.
+  void keepCommand(const LockedCommand& c) {
+    if (c.carried && commandEpoch && c.epoch == *commandEpoch && c.newest > lastCommandRun)
+      commandsHeld.insert_or_assign(c.newest, c.text);
+  }
+
+  /// Commands the leader re-sent on the DEALER socket (this follower asked for them).
+  void takeResentCommands() {
+    for (;;) {
+      std::array<std::byte, kMaxLockMessageBytes + 1> bytes{};
+      const int n = zmq_recv(answers.get(), bytes.data(), bytes.size(), ZMQ_DONTWAIT);
+      if (n < 0) return;
+      const auto size = std::min<std::size_t>(static_cast<std::size_t>(n), bytes.size());
+      auto m = decodeCommand(std::span<const std::byte>(bytes.data(), size));
+      if (!m) {
+        if (figures.malformed++ == 0) log::warn(kLogLock, "{}", m.error().message());
+        continue;
+      }
+      if (!commandEpoch || m->epoch != *commandEpoch) continue;  // for a log the leader has ended
+      ++figures.commandsResent;
+      if (m->earlierGone && m->seq > lastCommandRun + 1 && m->seq - 1 > commandBase) {
+        const std::uint32_t from = std::max(lastCommandRun, commandBase) + 1;
+        figures.commandsLost += m->seq - from;
+        log::warn(kLogLock,
+                  "the leader's commands {}..{} are gone from its log: this node's show misses them; reload the "
+                  "show on the leader (POST /control/reload) to bring every node to the same state",
+                  from, m->seq - 1);
+        lastCommandRun = m->seq - 1;
+      }
+      if (m->seq > lastCommandRun) commandsHeld.insert_or_assign(m->seq, std::move(m->text));
+    }
+  }
+
+  /// Runs the commands held in order, from the one after the last run; asks the leader for
+  /// those missing.
+  void runCommands(std::int64_t frame) {
+    if (!commandEpoch) return;
+    const std::uint64_t loads = director->showLoads();
+    if (commandsForShow && *commandsForShow != loads) {
+      // This node's show was (re)loaded: what ran on the old one went with it.
+      lastCommandRun = 0;
+      resendFrom = 0;
+    }
+    commandsForShow = loads;
+    if (director->loadingShow()) return;  // they run on the show being loaded, once it is on
+    // Commands before the leader's last show reset no longer act there; this node's show was
+    // reset at the same point (the programme it follows).
+    lastCommandRun = std::max(lastCommandRun, std::min(commandBase, commandsAnnounced));
+    for (auto it = commandsHeld.begin(); it != commandsHeld.end();) {
+      if (it->first <= lastCommandRun) {
+        it = commandsHeld.erase(it);
+        continue;
+      }
+      if (it->first != lastCommandRun + 1) break;
+      auto out = director->runLeaderCommand(it->second);
+      if (out) {
+        log::info(kLogLock, "frame {}: runs the leader's command {}: {}", frame, it->first, it->second);
+      } else {
+        log::warn(kLogLock, "frame {}: the leader's command {} '{}' failed on this node: {}", frame, it->first,
+                  it->second, out.error().describe());
+      }
+      ++figures.commandsApplied;
+      lastCommandRun = it->first;
+      it = commandsHeld.erase(it);
+    }
+    if (lastCommandRun < commandsAnnounced) askForCommands();
+  }
+
+  /// Asks the leader for its commands after the last run here: at once for a new gap, again
+  /// after 250 ms without an answer. Never blocks.
+  void askForCommands() {
+    const std::uint32_t from = lastCommandRun + 1;
+    const SystemClock wall;
+    const Nanos now = wall.now();
+    if (from == resendFrom && now - resendAt < std::chrono::milliseconds(250)) return;
+    resendFrom = from;
+    resendAt = now;
+    log::debug(kLogLock, "asks the leader for its commands {}..{}", from, commandsAnnounced);
+    send(answers.get(), encode(ResendMessage{*commandEpoch, from}, buffer));
   }
 
   void beforeDrawFollower() {
@@ -576,17 +767,19 @@ std::string FrameLock::describe() const {
     return fmt::format(
         "frame lock: leader '{}': {} followers in the barrier ({} known), {} frames presented without every answer, "
         "{} dropped, {} rejoined, {} late answers, barrier wait median {:.3f} ms max {:.3f} ms, largest follower "
-        "clock offset {} us, {} malformed messages, {} programme changes sent",
+        "clock offset {} us, {} malformed messages, {} programme changes sent, {} commands sent, {} re-sent",
         f.node, f.followers, f.followersKnown, f.barrierTimeouts, f.followersDropped, f.followersRejoined,
-        f.lateAnswers, f.barrierWaitP50Ms, f.barrierWaitMaxMs, f.maxClockOffsetUs, f.malformed, f.programmeChanges);
+        f.lateAnswers, f.barrierWaitP50Ms, f.barrierWaitMaxMs, f.maxClockOffsetUs, f.malformed, f.programmeChanges,
+        f.commandsApplied, f.commandsResent);
   }
   return fmt::format(
       "frame lock: follower '{}': drew {} frames, {}..{}, checksum {:016x}, {} skipped, {} presented without the "
       "leader's word, skew at most {} frames, leader lost {} times, clock offset {} us (largest {} us), delay median "
-      "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times, {} programme changes followed",
+      "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times, {} programme changes followed, {} of "
+      "the leader's commands run ({} re-sent, {} lost)",
       f.node, f.framesDrawn, f.firstFrame, f.lastFrame, f.frameChecksum, f.skipped, f.presentsMissed, f.maxSkewFrames,
       f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs, f.malformed, f.leaderReturned,
-      f.programmeChanges);
+      f.programmeChanges, f.commandsApplied, f.commandsResent, f.commandsLost);
 }
 
 }  // namespace basalt::kiosk

@@ -50,6 +50,20 @@ class LockedDirector {
   /// \brief Follower: plays the leader's programme from the frame at `showTime` on (called
   /// before any participant's beforeDraw). True when what plays changed.
   virtual bool followProgramme(const LockedProgramme& programme, Nanos showTime) = 0;
+  /// \brief Leader: the script commands it ran since its show was (re)loaded, which the lock
+  /// announces in each frame and re-sends to followers that missed some; null: none are run.
+  [[nodiscard]] virtual const LockCommandLog* commandLog() const { return nullptr; }
+  /// \brief Follower: how many times this node's show was (re)loaded. The leader's commands
+  /// applied to an earlier show went with it: the lock applies them again from the first.
+  [[nodiscard]] virtual std::uint64_t showLoads() const { return 0; }
+  /// \brief Follower: true while this node loads a show (the leader's commands wait for it).
+  [[nodiscard]] virtual bool loadingShow() const { return false; }
+  /// \brief Follower: runs one of the leader's script commands on this node's show (called by
+  /// the gate before any participant's beforeDraw, after followProgramme).
+  virtual Result<std::string> runLeaderCommand(std::string_view command) {
+    (void)command;
+    return fail(Errc::kUnsupported, "this director runs no script commands");
+  }
 };
 
 /// \brief One node of a frame-locked group: a FrameParticipant on both roles (add it last, so

@@ -291,6 +291,7 @@ void ShowDirector::pollReload(const FrameContext& frame) {
   const auto resume = policy_ ? std::optional<ResumePoint>(policy_->resumePoint(now)) : std::nullopt;
   takeOver(std::move(next), now, resume);
   ++reloadsApplied_;
+  commands_.restart(static_cast<std::uint32_t>(reloadsApplied_));  // the log starts with the show
   lastReloadFrame_ = frame.frame;
   context_.board.noteReloadApplied(frame.frame);
   context_.board.noteReload(true, fmt::format("reloaded at frame {}", frame.frame));
@@ -300,8 +301,22 @@ void ShowDirector::pollReload(const FrameContext& frame) {
 
 void ShowDirector::handleControls(const FrameContext& frame) {
   const Nanos now = frame.time;
+  const bool lockLeader = locked_ && !follower_;
+  bool commandRun = false;
   ControlRequest request;
-  while (context_.board.controls().pop(request)) {
+  for (;;) {
+    if (deferredCommand_) {
+      request = std::move(*deferredCommand_);
+      deferredCommand_.reset();
+    } else if (!context_.board.controls().pop(request)) {
+      break;
+    }
+    if (request.kind == ControlKind::kRunCommand && lockLeader && commandRun) {
+      // A frame carries one command to the followers: the next one waits for the next frame,
+      // and so do the requests after it, which keep their order.
+      deferredCommand_ = std::move(request);
+      break;
+    }
     auto& reply = *request.reply;
     switch (request.kind) {
       case ControlKind::kNext:
@@ -330,17 +345,10 @@ void ShowDirector::handleControls(const FrameContext& frame) {
           reply.answer(202, "reloading " + show_->manifest.file.string());
         }
         break;
-      case ControlKind::kRunCommand: {
-        auto out =
-            runScriptCommand(request.argument, {context_.show, &context_.renderer.textures(),
-                                                show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
-        if (out) {
-          reply.answer(200, *out);
-        } else {
-          reply.answer(out.error().code() == Errc::kUnsupported ? 501 : 400, out.error().describe());
-        }
+      case ControlKind::kRunCommand:
+        commandRun = lockLeader;
+        runCommand(frame, request);
         break;
-      }
       case ControlKind::kRestartDevice: {
         auto it = std::find_if(show_->devices.begin(), show_->devices.end(),
                                [&](const DeviceSlot& s) { return s.spec.name == request.argument; });
@@ -547,6 +555,7 @@ void ShowDirector::applyProgramme(Nanos now) {
     if (p.generation == appliedGeneration_) return;
     appliedGeneration_ = p.generation;
     player_ = nullptr;
+    commands_.markShowReset();  // every item starts its own Show: the commands so far no longer act
     const bool wantOff = p.display == DisplayState::kOff;
     if (wantOff && displayOn_ && !displayOffUnsupported_) {
       if (auto r = context_.output.setDisplayPower(false); r) {
@@ -669,6 +678,42 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
   if (now - lastSave_ >= kSaveEvery) saveState(now);
   return {};
 }
+
+void ShowDirector::runCommand(const FrameContext& frame, ControlRequest& request) {
+  auto& reply = *request.reply;
+  if (follower_) {
+    // One show for the group: a command run here alone would part this node's picture from the others'.
+    reply.answer(409,
+                 "this node follows its frame-lock leader, which runs script commands on every node: send the "
+                 "command to the leader's control server");
+    return;
+  }
+  const bool lockLeader = locked_;
+  if (lockLeader && request.argument.size() > kCommandTextBytes) {
+    reply.answer(400, fmt::format("a frame-locked leader runs commands of at most {} bytes (it sends them to its "
+                                  "followers); this one has {}",
+                                  kCommandTextBytes, request.argument.size()));
+    return;
+  }
+  auto out = runLeaderCommand(request.argument);
+  if (!out) {
+    reply.answer(out.error().code() == Errc::kUnsupported ? 501 : 400, out.error().describe());
+    return;
+  }
+  if (lockLeader) {
+    const std::uint32_t seq = commands_.add(request.argument);
+    log::info(kLogDirector, "frame {}: runs command {} for the frame-locked group: {}", frame.frame, seq,
+              request.argument);
+  }
+  reply.answer(200, *out);
+}
+
+Result<std::string> ShowDirector::runLeaderCommand(std::string_view command) {
+  return runScriptCommand(command, {context_.show, &context_.renderer.textures(),
+                                    show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
+}
+
+const LockCommandLog* ShowDirector::commandLog() const { return locked_ && !follower_ ? &commands_ : nullptr; }
 
 void ShowDirector::setLocked(bool leader, std::chrono::milliseconds patience) {
   locked_ = true;

@@ -84,6 +84,10 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
 
   [[nodiscard]] LockedProgramme lockedProgramme() const override;
   bool followProgramme(const LockedProgramme& programme, Nanos showTime) override;
+  [[nodiscard]] const LockCommandLog* commandLog() const override;
+  [[nodiscard]] std::uint64_t showLoads() const override { return showGeneration_; }
+  [[nodiscard]] bool loadingShow() const override { return loading_; }
+  Result<std::string> runLeaderCommand(std::string_view command) override;
 
   Result<void> beforeDraw(const FrameContext& frame) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
@@ -107,6 +111,8 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   void loadTexturesInBackground();
   void pollTextures();
   void handleControls(const FrameContext& frame);
+  /// Runs a control request's script command (on a leader: logs it for the followers).
+  void runCommand(const FrameContext& frame, ControlRequest& request);
   void serviceDevices(Nanos now);
   void applyInput(Nanos until);
   /// Keys and pointer from the output's window and from evdev keyboards and mice: activity for the kiosk, the facet
@@ -178,6 +184,10 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   std::chrono::milliseconds patience_{0};
   Nanos mediaStart_{0};  // show time the show's [media] streams start (leader: its show's take-over)
   std::optional<std::uint32_t> leaderReloads_;  // the leader's reload count last seen
+  // Leader: the script commands run since the show was (re)loaded, which the lock sends to the
+  // followers; at most one runs per frame, so that each frame carries the one it ran.
+  LockCommandLog commands_;
+  std::optional<ControlRequest> deferredCommand_;  // the next frame's command
 };
 
 }  // namespace basalt::kiosk

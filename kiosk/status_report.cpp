@@ -128,13 +128,15 @@ std::string healthJson(const StatusSnapshot& s) {
         "\"frames_drawn\": {}, \"last_frame\": {}, \"skipped\": {}, \"presents_missed\": {}, \"skew_frames_max\": {}, "
         "\"clock_offset_us\": {}, \"delay_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"malformed\": {}, "
         "\"holding\": {}, \"holding_seconds\": {:.1f}, \"held_frame\": {}, \"leader_returned\": {}, "
-        "\"watchdog_pings_holding\": {}, \"programme_changes\": {}}},\n",
+        "\"watchdog_pings_holding\": {}, \"programme_changes\": {}, \"commands_applied\": {}, "
+        "\"commands_resent\": {}, \"commands_lost\": {}}},\n",
         jsonString(l->leader ? "leader" : "follower"), jsonString(l->node), l->followers, l->followersKnown,
         l->barrierTimeouts, l->followersDropped, l->followersRejoined, l->lateAnswers, l->barrierWaitP50Ms,
         l->barrierWaitMaxMs, l->leaderPresent ? "true" : "false", l->leaderLost, l->framesDrawn, l->lastFrame,
         l->skipped, l->presentsMissed, l->maxSkewFrames, l->leader ? l->maxClockOffsetUs : l->clockOffsetUs,
         l->delayP50Ms, l->delayMaxMs, l->malformed, l->holding ? "true" : "false", l->holdingSeconds, l->heldFrame,
-        l->leaderReturned, l->watchdogPingsHolding, l->programmeChanges);
+        l->leaderReturned, l->watchdogPingsHolding, l->programmeChanges, l->commandsApplied, l->commandsResent,
+        l->commandsLost);
   }
   out += "  \"devices\": [";
   for (std::size_t i = 0; i < s.devices.size(); ++i) {
@@ -293,6 +295,16 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
                  l->clockOffsetUs);
     }
     lockMetric("basalt_lock_malformed_total", "counter", "Frame-lock messages rejected.", l->malformed);
+    lockMetric("basalt_lock_commands_applied_total", "counter",
+               l->leader ? "Script commands the leader ran for the group." : "The leader's script commands run here.",
+               l->commandsApplied);
+    lockMetric("basalt_lock_commands_resent_total", "counter",
+               l->leader ? "Commands re-sent to followers that missed them." : "Commands the leader re-sent here.",
+               l->commandsResent);
+    if (!l->leader) {
+      lockMetric("basalt_lock_commands_lost_total", "counter",
+                 "The leader's commands gone from its log before this node had them.", l->commandsLost);
+    }
   }
   metric("basalt_reloads_total", "counter", "Reloads asked for (SIGHUP or the control server).");
   out += fmt::format("basalt_reloads_total {}\n", s.reloads);

@@ -6,7 +6,8 @@
 // that a long outage does not get it restarted; the leader's return shows in /health).
 // Example failures: the follower switching a frame after the leader; a holding follower whose
 // watchdog goes quiet (systemd would kill every follower while the leader is down); a lost
-// leader the status page calls ok.
+// leader the status page calls ok. A script command sent to the leader runs on the follower in
+// the same frame, and the follower refuses one of its own.
 
 #include <gtest/gtest.h>
 
@@ -16,6 +17,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <cstring>
 #include <fstream>
@@ -24,6 +26,9 @@
 #include <string>
 #include <thread>
 
+#include <fmt/format.h>
+
+#include "media/image_io.h"
 #include "render/kiosk_process.h"
 #include "support/datagram_socket.h"
 #include "support/test_paths.h"
@@ -150,6 +155,92 @@ TEST(LockedKiosk, NextOnTheLeaderSwitchesTheFollowerInTheSameFrame) {
   EXPECT_EQ(*followed, *sent) << "the follower switched in another frame than the leader";
   EXPECT_NE(fr.output.find("1 programme changes followed"), std::string::npos) << fr.output;
   EXPECT_NE(lr.output.find("1 programme changes sent"), std::string::npos) << lr.output;
+}
+
+/// The frame in which a node's log says it ran script command `seq` of the group: "frame N:
+/// runs command 1 for the frame-locked group: ..." (leader) or "frame N: runs the leader's
+/// command 1: ..." (follower).
+std::optional<long> commandFrame(const std::string& output, const std::string& what, int seq) {
+  const std::regex line("frame (\\d+): runs " + what + " " + std::to_string(seq) + "[ :]");
+  std::smatch m;
+  if (!std::regex_search(output, m, line)) return std::nullopt;
+  return std::stol(m[1].str());
+}
+
+/// The red, green and blue of the top-left pixel of `show`'s /snapshot.png (the background
+/// around the default cube), or nothing when there is no snapshot.
+std::optional<std::array<int, 3>> cornerColour(const test::RunningShow& show, const std::string& name) {
+  const auto s = show.get("/snapshot.png");
+  if (s.status != 200) return std::nullopt;
+  const auto file = test::scratchDir(name) / "snapshot.png";
+  std::ofstream(file, std::ios::binary) << s.body;
+  auto image = media::readImage(file);
+  if (!image || image->width == 0) return std::nullopt;
+  return std::array<int, 3>{image->at(0, 0, 0), image->at(0, 0, 1), image->at(0, 0, 2)};
+}
+
+/// Polls `show`'s snapshot until its corner is red, at most `limit`.
+bool cornerTurnsRed(const test::RunningShow& show, const std::string& name, std::chrono::milliseconds limit,
+                    std::string& last) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  while (std::chrono::steady_clock::now() < end) {
+    if (const auto c = cornerColour(show, name)) {
+      last = fmt::format("{} {} {}", (*c)[0], (*c)[1], (*c)[2]);
+      if ((*c)[0] > 200 && (*c)[1] < 50 && (*c)[2] < 50) return true;
+    }
+    std::this_thread::sleep_for(100ms);
+  }
+  return false;
+}
+
+// Makes sure a script command sent to the leader's control server runs on the follower too, in
+// the leader's frame, and shows there (the follower's snapshot turns red), while the follower
+// refuses a command of its own. Example failure: the leader's background turns red and the
+// follower's facets stay black, or the follower runs a command that parts it from the group.
+TEST(LockedKiosk, ACommandOnTheLeaderRunsOnTheFollowerInTheSameFrame) {
+  REQUIRE_EGL();
+  const int port = lockPort(2);
+  const auto leaderShow = writeNode("lock-kiosk-command-leader", leaderLock(port));
+  const auto followerShow = writeNode("lock-kiosk-command-follower", followerLock(port, 3000));
+  std::string why;
+  auto leader = test::RunningShow::start({leaderShow.string(), "--realtime", "--no-resume"}, {}, why);
+  ASSERT_TRUE(leader) << why;
+  auto follower = test::RunningShow::start({followerShow.string(), "--realtime", "--no-resume"}, {}, why);
+  ASSERT_TRUE(follower) << why;
+  std::string last;
+  ASSERT_TRUE(healthSays(*follower, {"\"item\": \"first\"", "\"leader_present\": true"}, 20s, &last)) << last;
+  const auto before = cornerColour(*follower, "lock-kiosk-command-before");
+  ASSERT_TRUE(before);
+  EXPECT_LT((*before)[0], 200) << "the default background is not red";
+
+  const std::string bearer = std::string("Bearer ") + kToken;
+  const std::string red = "global.background_color = 1 0 0";
+  const auto refused = follower->post("/control/command", red, bearer);
+  EXPECT_EQ(refused.status, 409) << refused.body;
+  EXPECT_NE(refused.body.find("send the command to the leader's control server"), std::string::npos) << refused.body;
+
+  const auto ran = leader->post("/control/command", red, bearer);
+  ASSERT_EQ(ran.status, 200) << ran.body;
+  EXPECT_TRUE(healthSays(*follower, {"\"commands_applied\": 1"}, 5s, &last)) << last;
+  EXPECT_TRUE(cornerTurnsRed(*follower, "lock-kiosk-command-after", 5s, last)) << "corner " << last;
+  EXPECT_TRUE(cornerTurnsRed(*leader, "lock-kiosk-command-leader", 1s, last)) << "corner " << last;
+  const auto metrics = follower->get("/metrics").body;
+  EXPECT_EQ(test::metric(metrics, "basalt_lock_commands_applied_total{node=\"north\",role=\"follower\"}"), 1.0)
+      << metrics;
+
+  follower->process().signal(SIGTERM);
+  leader->process().signal(SIGTERM);
+  const auto fr = follower->process().wait(20s);
+  const auto lr = leader->process().wait(20s);
+  EXPECT_EQ(fr.exitCode, 0) << fr.output;
+  EXPECT_EQ(lr.exitCode, 0) << lr.output;
+  const auto sent = commandFrame(lr.output, "command", 1);
+  const auto followed = commandFrame(fr.output, "the leader's command", 1);
+  ASSERT_TRUE(sent) << lr.output;
+  ASSERT_TRUE(followed) << fr.output;
+  EXPECT_EQ(*followed, *sent) << "the follower ran the command in another frame than the leader";
+  EXPECT_NE(fr.output.find("1 of the leader's commands run"), std::string::npos) << fr.output;
+  EXPECT_NE(lr.output.find("1 commands sent"), std::string::npos) << lr.output;
 }
 
 using test::SocketDir;

@@ -375,6 +375,15 @@ LockSpec followerSpec(int port, std::string name, int leaderTimeoutMs = 2000) {
 struct FakeDirector final : public LockedDirector {
   LockedProgramme programme;
   std::vector<std::pair<std::int64_t, std::uint32_t>> followed;  // (show time in frames, item index)
+  LockCommandLog log;                                            // the leader's commands
+  std::vector<std::string> ran;                                  // a follower's: the leader's commands run, in order
+  std::uint64_t loads = 1;  // a follower's: its show's loads (a reload: the commands run again)
+  [[nodiscard]] const LockCommandLog* commandLog() const override { return &log; }
+  [[nodiscard]] std::uint64_t showLoads() const override { return loads; }
+  Result<std::string> runLeaderCommand(std::string_view command) override {
+    ran.emplace_back(command);
+    return std::string("done");
+  }
   FakeDirector() {
     programme.present = true;
     programme.hasItem = true;
@@ -392,6 +401,8 @@ struct FakeDirector final : public LockedDirector {
 
 struct FollowerNode {
   FakeDirector director;
+  std::int64_t reloadAfter = -1;         // the frame after which this node's show is reloaded
+  std::vector<std::size_t> commandsRun;  // how many of the leader's commands ran before each frame
   std::vector<std::int64_t> frames;
   std::vector<Mat4> globals;  // the show state drawn with each frame
   FrameLockFigures figures;
@@ -421,7 +432,9 @@ struct FollowerNode {
       EXPECT_TRUE((*lock)->beforeDraw(context));
       frames.push_back(context.frame);
       globals.push_back(show.position().global);
+      commandsRun.push_back(director.ran.size());
       EXPECT_TRUE((*lock)->afterDraw(context, output));
+      if (context.frame == reloadAfter) ++director.loads;
       if (stopAfter >= 0 && context.frame >= stopAfter) break;
     }
     figures = (*lock)->figures();
@@ -430,7 +443,9 @@ struct FollowerNode {
 
 struct LeaderNode {
   FakeDirector director;
-  std::int64_t switchAt = -1;  // the frame in which the leader's item becomes "b"
+  std::int64_t switchAt = -1;                    // the frame in which the leader's item becomes "b"
+  std::map<std::int64_t, std::string> commands;  // script commands its director runs, by frame
+  std::int64_t resetAt = -1;                     // the frame in which an item starts a new Show
   std::vector<Mat4> globals;
   FrameLockFigures figures;
   std::int64_t joined = 0;
@@ -457,6 +472,8 @@ struct LeaderNode {
         director.programme.setItemName("b");
         director.programme.itemStartNs = context.time.count();
       }
+      if (f == resetAt) director.log.markShowReset();
+      if (auto c = commands.find(f); c != commands.end()) director.log.add(c->second);  // a control request's
       EXPECT_TRUE((*lock)->beforeDraw(context));
       globals.push_back(show.position().global);
       EXPECT_TRUE((*lock)->afterDraw(context, output));
@@ -672,6 +689,101 @@ TEST(FrameLock, FollowersSwitchItemsInTheLeadersFrame) {
     EXPECT_EQ(f->figures.programmeChanges, 1);
   }
   EXPECT_EQ(leader.figures.programmeChanges, 1);
+}
+
+}  // namespace
+}  // namespace basalt::kiosk
+
+namespace basalt::kiosk {
+namespace {
+
+std::vector<std::string> valuesOf(const std::map<std::int64_t, std::string>& m) {
+  std::vector<std::string> v;
+  for (const auto& [frame, text] : m) v.push_back(text);
+  return v;
+}
+
+// Makes sure a script command run on the leader runs on both followers before they draw the
+// frame in which the leader ran it, and that a command too long for a frame still reaches them,
+// in order, by re-send. Example failure: the command applied after the frame was drawn (one
+// frame late), or a command after the long one run before it.
+TEST(FrameLock, CommandsRunOnEveryFollowerInTheLeadersFrame) {
+  const int port = freePortPair() + 10;
+  constexpr std::int64_t kFrames = 150;
+  LeaderNode leader;
+  leader.commands = {{30, "render.prim_type = wireframe"},
+                     {60, "background " + std::string(kFrameCommandBytes + 40, '1')},
+                     {61, "render.prim_type = points"},
+                     {100, "render.prim_type = solid"}};
+  FollowerNode a;
+  FollowerNode b;
+  std::thread ta([&] { a.run(followerSpec(port, "a")); });
+  std::thread tb([&] { b.run(followerSpec(port, "b")); });
+  std::thread tl([&] { leader.run(leaderSpec(port, 2, 2000), kFrames, std::chrono::microseconds(500)); });
+  tl.join();
+  ta.join();
+  tb.join();
+  ASSERT_TRUE(leader.failure.empty()) << leader.failure;
+  for (const FollowerNode* f : {&a, &b}) {
+    ASSERT_EQ(f->frames.size(), static_cast<std::size_t>(kFrames));
+    ASSERT_TRUE(contiguous(f->frames));
+    EXPECT_EQ(f->director.ran, valuesOf(leader.commands));
+    // Frame 30 is the first drawn with the first command, frame 100 with the fourth.
+    EXPECT_EQ(f->commandsRun[29], 0U);
+    EXPECT_EQ(f->commandsRun[30], 1U);
+    EXPECT_EQ(f->commandsRun[99], 3U);
+    EXPECT_EQ(f->commandsRun[100], 4U);
+    EXPECT_EQ(f->figures.commandsApplied, 4);
+    EXPECT_GE(f->figures.commandsResent, 1);  // the long one came by re-send
+    EXPECT_EQ(f->figures.malformed, 0);
+  }
+  EXPECT_EQ(leader.figures.commandsApplied, 4);
+  EXPECT_GE(leader.figures.commandsResent, 2);
+}
+
+// Makes sure a follower that missed the leader's commands (it was restarted while they ran)
+// gets them again by re-send and runs them in order, skipping those the leader's show no longer
+// holds (an item started after them), and that a follower whose own show is reloaded runs them
+// again. Example failure: a restarted follower that shows the scene without the commands run
+// while it was down, or runs them out of order after the newer one the frame carried.
+TEST(FrameLock, AFollowerThatMissedCommandsCatchesUpInOrder) {
+  const int port = freePortPair() + 12;
+  constexpr std::int64_t kFrames = 400;
+  LeaderNode leader;
+  leader.commands = {{20, "c1"}, {60, "c2"}, {120, "c3"}, {130, "c4"}, {135, "c5"}, {200, "c6"}, {250, "c7"}};
+  leader.resetAt = 110;  // c1 and c2 no longer act after it
+  FollowerNode a;
+  a.reloadAfter = 300;
+  FollowerNode killed;
+  FollowerNode restarted;
+  std::thread ta([&] { a.run(followerSpec(port, "a")); });
+  std::thread tb([&] {
+    killed.run(followerSpec(port, "b"), 100);
+    while (leader.frame.load() < 150) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    restarted.run(followerSpec(port, "b"));
+  });
+  leader.run(leaderSpec(port, 2, 50), kFrames, std::chrono::microseconds(2000));
+  ta.join();
+  tb.join();
+  ASSERT_EQ(leader.failure, "");
+  const std::vector<std::string> all = valuesOf(leader.commands);
+  ASSERT_EQ(killed.director.ran, (std::vector<std::string>{"c1", "c2"}));
+  ASSERT_FALSE(restarted.frames.empty());
+  EXPECT_GE(restarted.frames.front(), 150);
+  // c3..c5 by re-send before its first frame's drawing was over, then c6 and c7 in their frames.
+  EXPECT_EQ(restarted.director.ran, (std::vector<std::string>{"c3", "c4", "c5", "c6", "c7"}));
+  EXPECT_GE(restarted.figures.commandsResent, 3);
+  EXPECT_EQ(restarted.figures.commandsApplied, 5);
+  // Follower a ran all seven in their frames, then, its show reloaded after frame 300, the five
+  // that still act again.
+  std::vector<std::string> aWants = all;
+  aWants.insert(aWants.end(), {"c3", "c4", "c5", "c6", "c7"});
+  EXPECT_EQ(a.director.ran, aWants);
+  ASSERT_EQ(a.frames.size(), static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(a.commandsRun[200], 6U);
+  EXPECT_EQ(a.commandsRun[250], 7U);
+  EXPECT_GE(leader.figures.commandsResent, 8);
+  EXPECT_EQ(leader.figures.commandsApplied, 7);
 }
 
 }  // namespace
