@@ -1110,6 +1110,114 @@ FrameRef MoviePlayer::frameAt(Nanos showTime) {
   return f;
 }
 
+NumberedFrame MoviePlayer::frameNumbered(std::int64_t index, Nanos showTime, std::chrono::milliseconds patience) {
+  lastShowTime_ = showTime;
+  if (needShowAnchor_ && !awaitFirst_) {
+    anchorShow_ = showTime;
+    needShowAnchor_ = false;
+  }
+  NumberedFrame out;
+  const MovieInfo movie = info();
+  const std::int64_t count = movie.frameCount;
+  if (index < 0 || (movie.frameCountExact && count > 0 && index >= count)) {
+    out.outcome = NumberedOutcome::kLate;  // not a frame of this clip: nothing to wait for
+    return out;
+  }
+  // Frames from `from` on to `to`, through the end of the clip into the next loop.
+  const auto forward = [count](std::int64_t from, std::int64_t to) {
+    return count > 0 ? ((to - from) % count + count) % count : to - from;
+  };
+  const auto generationOf = [](const FrameRef& f) { return f->producerCookie >> 16; };
+  if (!awaitFirst_ && shownIndex_ == index && shownGeneration_ == generation_) {
+    // On screen already; the player's own timeline would move on if the next frame were due
+    // (one frame later when it is not decoded yet).
+    const FrameRef next = carry_ ? carry_ : impl_->queue.peekFront();
+    const Nanos nextPts = next && generationOf(next) == generation_ ? next->pts : shownPts_ + frameDuration();
+    const bool movesOn = nextPts <= targetTime(showTime);
+    out.outcome = movesOn ? NumberedOutcome::kCorrected : NumberedOutcome::kAgreed;
+    return out;
+  }
+  // What the player's own timeline picks now: the newest frame due at this target.
+  const Nanos target = targetTime(showTime);
+  const bool seekPending = awaitFirst_;
+  // The frame before the next one the player hands out: the one on screen, or the one before a
+  // pending seek's target.
+  std::int64_t before = awaitFirst_ ? pendingIndex_ - 1 : shownIndex_;
+  std::int64_t ahead = forward(before, index);
+  // A pending seek's first frame is what the player's own path shows next.
+  bool corrected = seekPending && index != pendingIndex_;
+  const bool behind = count > 0 ? ahead == 0 || ahead > count / 2 : ahead <= 0;
+  if (behind) {
+    requestSeek(index);
+    seekDueAt_ = showTime;
+    before = pendingIndex_ - 1;
+    ahead = forward(before, index);
+    corrected = true;
+  }
+  const SystemClock clock;
+  const Nanos deadline = clock.now() + patience;
+  FrameRef taken;
+  for (;;) {
+    FrameRef front = carry_ ? carry_ : impl_->queue.peekFront();
+    if (front) {
+      const bool carried = static_cast<bool>(carry_);
+      const auto pop = [&](bool passOver) {
+        if (carried) {
+          carry_.reset();
+        } else {
+          (void)impl_->queue.takeFront(passOver);
+        }
+      };
+      if (generationOf(front) != generation_) {
+        pop(true);  // decoded before a seek
+        continue;
+      }
+      if (awaitFirst_) {
+        // The seek's first frame anchors the timeline as frameAt() would anchor it.
+        awaitFirst_ = false;
+        anchorPts_ = front->pts;
+        anchorShow_ = seekDueAt_ ? *seekDueAt_ : showTime;
+        seekDueAt_.reset();
+        needShowAnchor_ = false;
+      }
+      const auto number = static_cast<std::int64_t>(front->sequence);
+      if (number == index) {
+        pop(false);
+        taken = std::move(front);
+        break;
+      }
+      if (forward(before, number) < ahead) {
+        pop(true);  // before the frame asked for
+        continue;
+      }
+      break;  // past it: the decoder never made it
+    }
+    std::unique_lock lock(impl_->mutex);
+    if (impl_->state == MovieState::kFailed || impl_->state == MovieState::kEmpty) break;
+    if (impl_->ended && impl_->endedGeneration == generation_) break;
+    if (clock.now() >= deadline) break;
+    impl_->progressCv.wait_for(lock, std::chrono::milliseconds(5));
+  }
+  if (!taken) {
+    out.outcome = NumberedOutcome::kLate;
+    return out;
+  }
+  if (!corrected && !seekPending) {
+    // The own timeline shows it now if it is due and the frame after it is not.
+    const FrameRef next = impl_->queue.peekFront();
+    const Nanos nextPts = next && generationOf(next) == generation_ ? next->pts : taken->pts + frameDuration();
+    corrected = taken->pts > target || nextPts <= target;
+  }
+  shownIndex_ = index;
+  shownClip_ = static_cast<std::size_t>(taken->producerCookie & 0xffff);
+  shownPts_ = taken->pts;
+  shownGeneration_ = generation_;
+  impl_->shown.fetch_add(1, std::memory_order_relaxed);
+  out.frame = std::move(taken);
+  out.outcome = corrected ? NumberedOutcome::kCorrected : NumberedOutcome::kAgreed;
+  return out;
+}
+
 Result<MovieInfo> MoviePlayer::waitUntilLoaded(std::chrono::milliseconds timeout) {
   std::unique_lock lock(impl_->mutex);
   const bool done = impl_->progressCv.wait_for(lock, timeout, [this] {

@@ -77,6 +77,19 @@ struct MoviePlayerStats {
   std::uint64_t stalls = 0;   ///< times a stalled pipeline was built again
 };
 
+/// \brief How MoviePlayer::frameNumbered() came by its frame.
+enum class NumberedOutcome : std::uint8_t {
+  kAgreed,     ///< the frame asked for is the one the player's own timeline shows at that time
+  kCorrected,  ///< the player's own timeline would have shown another frame (or a seek was needed)
+  kLate,       ///< the frame asked for did not come within the patience: the shown frame stays
+};
+
+/// \brief A frame asked for by its number, and how it was come by.
+struct NumberedFrame {
+  FrameRef frame;  ///< empty when the frame on screen stays (it is the one asked for, or it came late)
+  NumberedOutcome outcome = NumberedOutcome::kAgreed;
+};
+
 /// \brief A movie file (or a playlist of them) as a FrameSource, with LAVA's VCR controls.
 ///
 /// Threading: every public function is called on the frame loop's thread, except the wait
@@ -160,6 +173,17 @@ class MoviePlayer final : public FrameSource {
   void injectStall();
   /// \brief Waits until the loaded movie is ready or failed (tests, tools, `basalt check`).
   [[nodiscard]] Result<MovieInfo> waitUntilLoaded(std::chrono::milliseconds timeout);
+  /// \brief Frame-locked followers: frame `index` of the clip (its number from 0, as
+  /// currentFrame() counts), whatever the player's own timeline says at `showTime`: the leader
+  /// says which frame it shows, and two decoders' timestamps need not add up alike. The queued
+  /// frames before it are passed over; one not decoded yet is waited for, at most `patience`
+  /// (then the shown frame stays: kLate). A frame behind the player (the one on screen is later,
+  /// or the number is nearer behind it than ahead of it in the loop) is gone from the queue: the
+  /// player seeks back to it, due at `showTime`, rather than hold a frame the leader does not
+  /// show. Frame 0 after the clip's last is the next loop's. Empty frame when the shown one is
+  /// the one asked for. The timeline's anchor is kept, so frameAt() can take over again.
+  NumberedFrame frameNumbered(std::int64_t index, Nanos showTime, std::chrono::milliseconds patience);
+
   /// \brief For offline rendering on a manual clock only: waits until the frame due at
   /// `showTime` has been decoded (or the clip ended or failed), so that every frame of a fast
   /// run is exact. A show on the system clock never calls this.

@@ -66,6 +66,23 @@ bool FrameQueue::frontPts(Nanos& pts) const {
   return true;
 }
 
+FrameRef FrameQueue::peekFront() const {
+  std::lock_guard lock(mutex_);
+  return size_ == 0 ? FrameRef{} : slots_[head_];
+}
+
+FrameRef FrameQueue::takeFront(bool passOver) {
+  FrameRef f;
+  {
+    std::lock_guard lock(mutex_);
+    if (size_ == 0) return f;
+    f = popFrontLocked();
+    if (passOver) ++dropped_;
+  }
+  room_.notify_all();
+  return f;
+}
+
 void FrameQueue::clear() {
   std::vector<FrameRef> released;
   {

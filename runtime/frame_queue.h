@@ -63,6 +63,12 @@ class FrameQueue {
   FrameRef takeDue(Nanos now);
   /// \brief The pts of the oldest queued frame, if any (for pre-roll and gap checks).
   [[nodiscard]] bool frontPts(Nanos& pts) const;
+  /// \brief The oldest queued frame, left in the queue (a consumer looking for a frame by its
+  /// number); empty when none is queued.
+  [[nodiscard]] FrameRef peekFront() const;
+  /// \brief Takes the oldest queued frame out, counted as passed over when `passOver` (it is
+  /// dropped rather than shown); empty when none is queued.
+  FrameRef takeFront(bool passOver = false);
   /// \brief Drops every queued frame (on seek, stop, source change).
   void clear();
   /// \brief Wakes waiting producers for good (shutdown); later waits return false at once.
