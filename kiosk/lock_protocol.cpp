@@ -258,6 +258,9 @@ std::size_t encode(const FrameMessage& m, LockBuffer& out) {
   w.put(static_cast<std::uint8_t>(carried ? 1U : 0U));
   w.put(std::uint8_t{0});
   w.padded(carried ? std::string_view(c.text) : std::string_view(), kFrameCommandBytes);
+  w.put(m.movies.item);
+  for (const std::int32_t shown : m.movies.textures) w.put(shown);
+  w.put(std::uint32_t{0});
   return w.size();
 }
 
@@ -403,6 +406,18 @@ Result<FrameMessage> decodeFrame(std::span<const std::byte> bytes) {
   }
   if (c.base > c.newest) {
     return failf(Errc::kParse, "frame-lock message: command base {} is beyond the newest command {}", c.base, c.newest);
+  }
+  LockedMovieFrames& movies = m.movies;
+  movies.item = r.get<std::int32_t>();
+  for (std::int32_t& shown : movies.textures) shown = r.get<std::int32_t>();
+  const auto reserved4 = r.get<std::uint32_t>();
+  if (reserved4 != 0) {
+    return fail(Errc::kParse,
+                "frame-lock message: the 'frame' message's reserved bytes after the movie frames are not zero");
+  }
+  if (movies.item < -1 ||
+      std::any_of(movies.textures.begin(), movies.textures.end(), [](std::int32_t shown) { return shown < -1; })) {
+    return fail(Errc::kParse, "frame-lock message: a movie frame below -1 (-1 means none)");
   }
   if (auto f = finiteOrFail(r, LockMessageKind::kFrame); !f) return std::unexpected(f.error());
   if (m.frame < 0) return failf(Errc::kParse, "frame-lock message: frame number {} is negative", m.frame);

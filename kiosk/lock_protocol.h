@@ -11,7 +11,8 @@
 /// version, an unknown kind or a non-finite number is rejected with the reason. Version 2 added
 /// the director's programme (LockedProgramme) to the `frame` message; version 3 the leader's
 /// script commands (LockedCommand in `frame`, and the `resend` and `command` kinds that bring a
-/// follower the commands it missed).
+/// follower the commands it missed) and the movie frame each of its movies shows
+/// (LockedMovieFrames in `frame`).
 
 #include <algorithm>
 #include <array>
@@ -101,6 +102,17 @@ struct LockedCommand {
   friend bool operator==(const LockedCommand&, const LockedCommand&) = default;
 };
 
+/// \brief The movie frame each of the leader's movies shows in a frame (thesis §4.5: every node
+/// shows the same video frame): its number in its clip, -1 for none (no such movie, nothing on
+/// screen yet). A follower shows exactly these frames, whatever its own decoder's timestamps add
+/// up to (MoviePlayer::frameNumbered).
+struct LockedMovieFrames {
+  std::int32_t item = -1;  ///< the movie item of the playlist
+  /// The show's first movie streams, in the manifest's texture order (as LockedProgramme::moviePassNs).
+  std::array<std::int32_t, 4> textures{-1, -1, -1, -1};
+  friend bool operator==(const LockedMovieFrames&, const LockedMovieFrames&) = default;
+};
+
 enum class LockMessageKind : std::uint8_t {
   kFrame = 1,    ///< leader -> all: draw frame N with this state
   kPresent = 2,  ///< leader -> all: present frame N now
@@ -117,7 +129,8 @@ struct FrameMessage {
   std::int64_t sentNs = 0;      ///< when the leader sent it, on the shared clock (delay figures)
   LockedShowState state;
   LockedProgramme programme;
-  LockedCommand command;  ///< since version 3
+  LockedCommand command;     ///< since version 3
+  LockedMovieFrames movies;  ///< since version 3
   friend bool operator==(const FrameMessage&, const FrameMessage&) = default;
 };
 
@@ -172,8 +185,10 @@ constexpr std::size_t kLockedProgrammeBytes = 96;
 /// The epoch, the newest and base numbers, the text's length, flags, a reserved byte and the
 /// text, NUL-padded.
 constexpr std::size_t kLockedCommandBytes = 16 + kFrameCommandBytes;
+/// The item's and four textures' movie frames, four reserved bytes.
+constexpr std::size_t kLockedMovieFramesBytes = 24;
 constexpr std::size_t kFrameMessageBytes =
-    kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes + kLockedCommandBytes;
+    kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes + kLockedCommandBytes + kLockedMovieFramesBytes;
 constexpr std::size_t kPresentMessageBytes = kLockHeaderBytes + 8;
 constexpr std::size_t kReadyMessageBytes = kLockHeaderBytes + 24 + 32;
 constexpr std::size_t kByeMessageBytes = kLockHeaderBytes + 8;

@@ -53,6 +53,8 @@ basalt::kiosk::FrameMessage frame() {
   m.command.epoch = 1;
   m.command.newest = 3;
   m.command.base = 1;
+  m.movies.item = 17;
+  m.movies.textures = {29, -1, -1, -1};
   return m;
 }
 

@@ -54,6 +54,8 @@ FrameMessage sampleFrame() {
   m.command.base = 3;
   m.command.carried = true;
   m.command.text = "render.prim_type = wireframe";
+  m.movies.item = 17;
+  m.movies.textures = {29, 0, -1, 1'000'000};
   return m;
 }
 
@@ -249,6 +251,48 @@ TEST(LockProtocol, BadCommandFieldsAreRejectedWithTheReason) {
   // A command where a frame is expected, and the other way round.
   EXPECT_FALSE(decodeFrame(bytesOf(b, cn)));
   EXPECT_FALSE(decodeCommand(bytesOf(b, encode(sampleFrame(), b))));
+}
+
+// Makes sure the movie frames a frame announces come through as sent, none (-1) included, and
+// that a number below -1 or a reserved byte that is not zero is rejected with the reason.
+// Example failure: a corrupt frame makes a follower seek its movie to frame -7.
+TEST(LockProtocol, MovieFramesRoundTripAndBadOnesAreRejected) {
+  LockBuffer b{};
+  FrameMessage none = sampleFrame();
+  none.movies = {};
+  auto back = decodeFrame(bytesOf(b, encode(none, b)));
+  ASSERT_TRUE(back) << back.error().message();
+  EXPECT_EQ(back->movies.item, -1);
+  EXPECT_EQ(back->movies.textures, (std::array<std::int32_t, 4>{-1, -1, -1, -1}));
+  const std::size_t n = encode(sampleFrame(), b);
+  back = decodeFrame(bytesOf(b, n));
+  ASSERT_TRUE(back) << back.error().message();
+  EXPECT_EQ(back->movies, sampleFrame().movies);
+
+  constexpr std::size_t kMoviesAt = kFrameMessageBytes - kLockedMovieFramesBytes;
+  const auto rejects = [&](FrameMessage m, std::string_view why) {
+    LockBuffer bad{};
+    auto d = decodeFrame(bytesOf(bad, encode(m, bad)));
+    ASSERT_FALSE(d) << "accepted item " << m.movies.item << ", textures " << m.movies.textures[0] << " "
+                    << m.movies.textures[3];
+    EXPECT_NE(d.error().message().find(why), std::string::npos) << d.error().message();
+  };
+  FrameMessage m = sampleFrame();
+  m.movies.item = -2;
+  rejects(m, "movie frame below -1");
+  for (std::size_t i = 0; i < 4; ++i) {
+    m = sampleFrame();
+    m.movies.textures[i] = std::numeric_limits<std::int32_t>::min();
+    rejects(m, "movie frame below -1");
+  }
+  for (std::size_t at = kMoviesAt + 20; at < kFrameMessageBytes; ++at) {
+    LockBuffer bad = b;
+    bad[at] = std::byte{1};
+    auto d = decodeFrame(bytesOf(bad, n));
+    ASSERT_FALSE(d) << "accepted reserved byte " << at - kMoviesAt - 20 << " = 1";
+    EXPECT_NE(d.error().message().find("reserved bytes after the movie frames"), std::string::npos)
+        << d.error().message();
+  }
 }
 
 // Makes sure the leader's log numbers commands from 1, keeps the newest kKept, and starts again
