@@ -218,6 +218,7 @@ struct FrameLock::Impl {
     if (director) {
       m.programme = director->lockedProgramme();
       m.programme.present = true;
+      m.movies = director->lockedMovieFrames();
       noteProgramme(m.frame, m.programme, "sends");
       if (const LockCommandLog* commands = director->commandLog()) announceCommands(*commands, m.command);
     }
@@ -447,6 +448,8 @@ struct FrameLock::Impl {
         if (director && f.programme.present) {
           if (director->followProgramme(f.programme, Nanos{f.showTimeNs}))
             noteProgramme(f.frame, f.programme, "follows");
+          // The movie frames the leader shows in this frame: the follower's movies show them.
+          director->followMovieFrames(f.movies);
         }
         // Then the leader's script commands, in order: those it ran in this frame act in it on
         // every node (after the programme, which may have reset the show, as on the leader).
@@ -575,6 +578,12 @@ struct FrameLock::Impl {
   }
 
   void beforeDrawFollower() {
+    if (director) {
+      // The director drew its movies before this (the lock is the last participant).
+      const LockedMovieCounts movies = director->movieFrameCounts();
+      figures.movieFramesCorrected = movies.corrected;
+      figures.movieFramesLate = movies.late;
+    }
     if (!pending) return;
     applyLockedState(pending->state, show);
     pending.reset();
@@ -776,10 +785,11 @@ std::string FrameLock::describe() const {
       "frame lock: follower '{}': drew {} frames, {}..{}, checksum {:016x}, {} skipped, {} presented without the "
       "leader's word, skew at most {} frames, leader lost {} times, clock offset {} us (largest {} us), delay median "
       "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times, {} programme changes followed, {} of "
-      "the leader's commands run ({} re-sent, {} lost)",
+      "the leader's commands run ({} re-sent, {} lost), {} movie frames corrected to the leader's, {} late",
       f.node, f.framesDrawn, f.firstFrame, f.lastFrame, f.frameChecksum, f.skipped, f.presentsMissed, f.maxSkewFrames,
       f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs, f.malformed, f.leaderReturned,
-      f.programmeChanges, f.commandsApplied, f.commandsResent, f.commandsLost);
+      f.programmeChanges, f.commandsApplied, f.commandsResent, f.commandsLost, f.movieFramesCorrected,
+      f.movieFramesLate);
 }
 
 }  // namespace basalt::kiosk

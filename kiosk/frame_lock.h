@@ -39,6 +39,12 @@ class LockClockProbe {
   [[nodiscard]] virtual Nanos offset() const = 0;
 };
 
+/// \brief Follower: what its movies did with the leader's movie frames (MoviePlayer::frameNumbered).
+struct LockedMovieCounts {
+  std::int64_t corrected = 0;  ///< shown by number, though this node's own timeline would have shown another
+  std::int64_t late = 0;       ///< not decoded in time: the frame before stayed
+};
+
 /// \brief The kiosk's director as the lock sees it (kiosk/show_director.h): the leader sends its
 /// programme with every frame; a follower takes the leader's before each frame is drawn, so that
 /// an item switched on the leader is switched on every node in the same frame.
@@ -50,6 +56,14 @@ class LockedDirector {
   /// \brief Follower: plays the leader's programme from the frame at `showTime` on (called
   /// before any participant's beforeDraw). True when what plays changed.
   virtual bool followProgramme(const LockedProgramme& programme, Nanos showTime) = 0;
+  /// \brief Leader: the movie frame each of its movies shows in this frame (called in the lock's
+  /// beforeDraw, after the director's).
+  [[nodiscard]] virtual LockedMovieFrames lockedMovieFrames() const { return {}; }
+  /// \brief Follower: the leader's movie frames for the frame about to be drawn (called by the
+  /// gate after followProgramme): its movies show exactly these.
+  virtual void followMovieFrames(const LockedMovieFrames& frames) { (void)frames; }
+  /// \brief Follower: its movies' frames shown by the leader's number so far.
+  [[nodiscard]] virtual LockedMovieCounts movieFrameCounts() const { return {}; }
   /// \brief Leader: the script commands it ran since its show was (re)loaded, which the lock
   /// announces in each frame and re-sends to followers that missed some; null: none are run.
   [[nodiscard]] virtual const LockCommandLog* commandLog() const { return nullptr; }

@@ -40,6 +40,11 @@ struct FrameLockFigures {
   std::int64_t commandsApplied = 0;   ///< script commands run (leader: its own, logged; follower: the leader's)
   std::int64_t commandsResent = 0;    ///< commands re-sent (leader: to followers that asked; follower: received)
   std::int64_t commandsLost = 0;      ///< follower: the leader's commands gone from its log before this node had them
+  /// Follower: movie frames shown by the leader's number that this node's own timeline would not
+  /// have picked (its decoder's timestamps came out a hair off the leader's), and those not
+  /// decoded in time (the frame before stayed).
+  std::int64_t movieFramesCorrected = 0;
+  std::int64_t movieFramesLate = 0;
   std::uint64_t watchdogPingsHolding = 0;  ///< systemd watchdog pings sent while holding (run_command fills it)
   std::int64_t clockOffsetUs = 0;          ///< shared clock minus own clock at the last frame
   std::int64_t maxClockOffsetUsSeen = 0;

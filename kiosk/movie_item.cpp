@@ -74,6 +74,7 @@ class MovieItem final : public ItemPlayer {
   }
 
   Result<void> beforeDraw(const FrameContext& frame, runtime::Show& /*show*/) override {
+    leaderResult_ = LeaderFrameResult::kNone;
     if (endsAt_) {
       // The last frame stays up for its own duration, then the item ends.
       if (frame.time >= *endsAt_) ended_ = true;
@@ -85,13 +86,22 @@ class MovieItem final : public ItemPlayer {
         playback_.manualClock     ? std::chrono::duration_cast<std::chrono::milliseconds>(kFrameTimeout)
         : playback_.timelineStart ? playback_.patience
                                   : std::chrono::milliseconds(0);
-    if (patience.count() > 0) player_->waitForFrameDue(frame.time, patience);
-    FrameRef f = player_->frameAt(frame.time);
-    if (f && playback_.timelineStart && patience.count() > 0) {
-      // The frame a seek onto the timeline brought was due when the item started; a node that
-      // waited for it takes the frame due now as well, as the others do in this frame.
-      player_->waitForFrameDue(frame.time, patience);
-      if (FrameRef newer = player_->frameAt(frame.time)) f = std::move(newer);
+    FrameRef f;
+    if (playback_.timelineStart && leaderFrame_ >= 0) {
+      // A follower shows the leader's frame by its number, not by its own decoder's timestamps
+      // (which can add up a fraction of a millisecond apart from the leader's).
+      media::NumberedFrame pick = player_->frameNumbered(leaderFrame_, frame.time, patience);
+      f = std::move(pick.frame);
+      leaderResult_ = leaderFrameResultOf(pick.outcome);
+    } else {
+      if (patience.count() > 0) player_->waitForFrameDue(frame.time, patience);
+      f = player_->frameAt(frame.time);
+      if (f && playback_.timelineStart && patience.count() > 0) {
+        // The frame a seek onto the timeline brought was due when the item started; a node that
+        // waited for it takes the frame due now as well, as the others do in this frame.
+        player_->waitForFrameDue(frame.time, patience);
+        if (FrameRef newer = player_->frameAt(frame.time)) f = std::move(newer);
+      }
     }
     const media::MovieState state = player_->state();
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) return std::unexpected(failure());
@@ -121,6 +131,9 @@ class MovieItem final : public ItemPlayer {
   [[nodiscard]] std::int64_t shownFrame() const override {
     return texture_ && !texture_->showingFallback() ? player_->currentFrame() : -1;
   }
+
+  void setLeaderFrame(std::int64_t frame) override { leaderFrame_ = frame; }
+  [[nodiscard]] LeaderFrameResult leaderFrameResult() const override { return leaderResult_; }
 
  private:
   /// Frame-locked: seeks to the frame due `position` after the item's start on the group's
@@ -165,10 +178,21 @@ class MovieItem final : public ItemPlayer {
   Playback playback_;
   bool started_ = false;
   bool ended_ = false;
-  std::optional<Nanos> endsAt_;  // show time the shown last frame ends at (not looping)
+  std::optional<Nanos> endsAt_;    // show time the shown last frame ends at (not looping)
+  std::int64_t leaderFrame_ = -1;  // frame-locked follower: the leader's movie frame in the coming frame
+  LeaderFrameResult leaderResult_ = LeaderFrameResult::kNone;
 };
 
 }  // namespace
+
+LeaderFrameResult leaderFrameResultOf(media::NumberedOutcome outcome) {
+  switch (outcome) {
+    case media::NumberedOutcome::kAgreed: return LeaderFrameResult::kAgreed;
+    case media::NumberedOutcome::kCorrected: return LeaderFrameResult::kCorrected;
+    case media::NumberedOutcome::kLate: return LeaderFrameResult::kLate;
+  }
+  return LeaderFrameResult::kNone;
+}
 
 render::PictureRect letterbox(double pictureWidth, double pictureHeight, render::Size output) {
   if (!(pictureWidth > 0) || !(pictureHeight > 0) || output.width == 0 || output.height == 0) return {};

@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -607,9 +608,15 @@ void ShowDirector::applyProgramme(Nanos now) {
 
 void ShowDirector::updateStreams(Nanos now) {
   bool changed = false;
+  std::size_t movie = 0;  // as lockedMovieFrames() counts them
   for (LoadedTexture& t : show_->textures) {
     if (!t.stream) continue;
+    if (follower_) {
+      t.stream->setLeaderFrame(movie < leaderMovies_.textures.size() ? leaderMovies_.textures[movie] : -1);
+      ++movie;
+    }
     const bool live = t.stream->update(now, context_.renderer.textures(), t.name);
+    if (follower_) countLeaderFrame(t.stream->leaderFrameResult());
     const std::optional<SourceState> device = t.stream->deviceState();
     if (live == t.live && device == t.deviceState) continue;
     t.deviceState = device;
@@ -646,7 +653,11 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
   // A frame-locked follower's programme is the leader's (followProgramme): it decides nothing.
   if (!follower_ && policy_->update(now, context_.clock.wallNow())) applyProgramme(now);
   if (player_) {
-    if (auto r = player_->beforeDraw(frame, context_.show); !r) {
+    // A follower's movie item shows the leader's movie frame (none on a leader: it decides).
+    if (follower_) player_->setLeaderFrame(leaderMovies_.item);
+    const Result<void> r = player_->beforeDraw(frame, context_.show);
+    if (r && follower_) countLeaderFrame(player_->leaderFrameResult());
+    if (!r) {
       log::error(kLogDirector, "'{}' stopped: {}; moving on", policy_->current().item->name, r.error().describe());
       if (follower_) {
         player_ = nullptr;
@@ -675,8 +686,30 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
                  shown);
     }
   }
+  // Used up: the next frame brings its own (none: each movie keeps to its own timeline).
+  leaderMovies_ = {};
   if (now - lastSave_ >= kSaveEvery) saveState(now);
   return {};
+}
+
+void ShowDirector::countLeaderFrame(LeaderFrameResult result) {
+  if (result == LeaderFrameResult::kCorrected) ++movieCounts_.corrected;
+  if (result == LeaderFrameResult::kLate) ++movieCounts_.late;
+}
+
+LockedMovieFrames ShowDirector::lockedMovieFrames() const {
+  LockedMovieFrames l;
+  const auto number = [](std::int64_t shown) {
+    return shown >= 0 && shown <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(shown) : -1;
+  };
+  if (player_ && policy_ && policy_->current().item) l.item = number(player_->shownFrame());
+  if (!show_) return l;
+  std::size_t movie = 0;
+  for (const LoadedTexture& t : show_->textures) {
+    if (!t.stream || movie == l.textures.size()) continue;
+    l.textures[movie++] = number(t.stream->shownFrame());
+  }
+  return l;
 }
 
 void ShowDirector::runCommand(const FrameContext& frame, ControlRequest& request) {

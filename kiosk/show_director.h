@@ -84,6 +84,9 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
 
   [[nodiscard]] LockedProgramme lockedProgramme() const override;
   bool followProgramme(const LockedProgramme& programme, Nanos showTime) override;
+  [[nodiscard]] LockedMovieFrames lockedMovieFrames() const override;
+  void followMovieFrames(const LockedMovieFrames& frames) override { leaderMovies_ = frames; }
+  [[nodiscard]] LockedMovieCounts movieFrameCounts() const override { return movieCounts_; }
   [[nodiscard]] const LockCommandLog* commandLog() const override;
   [[nodiscard]] std::uint64_t showLoads() const override { return showGeneration_; }
   [[nodiscard]] bool loadingShow() const override { return loading_; }
@@ -130,6 +133,8 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   void cameraRow(DeviceStatus& d, const DeviceSlot& slot) const;
   /// Removes the textures the last item put in the registry, unless `nextKey` is that same item.
   void releaseItemTextures(const std::string& nextKey);
+  /// Frame-locked follower: counts what a movie did with the leader's frame.
+  void countLeaderFrame(LeaderFrameResult result);
   /// Frame-locked: puts every movie stream of the show on the timeline from mediaStart_.
   void alignStreams();
   /// How the item `p` plays: looped or once, exact offline, on the group's timeline when locked.
@@ -184,6 +189,8 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   std::chrono::milliseconds patience_{0};
   Nanos mediaStart_{0};  // show time the show's [media] streams start (leader: its show's take-over)
   std::optional<std::uint32_t> leaderReloads_;  // the leader's reload count last seen
+  LockedMovieFrames leaderMovies_;              // follower: the leader's movie frames for this frame
+  LockedMovieCounts movieCounts_;               // follower: what its movies did with them
   // Leader: the script commands run since the show was (re)loaded, which the lock sends to the
   // followers; at most one runs per frame, so that each frame carries the one it ran.
   LockCommandLog commands_;

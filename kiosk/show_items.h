@@ -27,6 +27,14 @@
 
 namespace basalt::kiosk {
 
+/// \brief Frame-locked followers: how a movie came by the frame it showed in the last frame.
+enum class LeaderFrameResult : std::uint8_t {
+  kNone,       ///< no frame of the leader's was given (a leader, an unlocked show, the leader shows none)
+  kAgreed,     ///< the leader's frame, which this node's own timeline picked too
+  kCorrected,  ///< the leader's frame, which this node's own timeline would not have picked
+  kLate,       ///< the leader's frame did not come in time: the frame before it stayed
+};
+
 /// \brief Plays one item into the Show.
 ///
 /// Threading: made on the show loader's thread (files are read there), then used on the frame
@@ -70,6 +78,11 @@ class ItemPlayer {
   /// \brief The movie frame on screen (a movie item's number in its clip), or -1: frame-locked
   /// nodes are compared with it.
   [[nodiscard]] virtual std::int64_t shownFrame() const { return -1; }
+  /// \brief Frame-locked followers: the movie frame the leader shows in the coming frame (its
+  /// shownFrame()), which beforeDraw() shows exactly; -1: none given (the item's own timeline).
+  virtual void setLeaderFrame(std::int64_t frame) { (void)frame; }
+  /// \brief What the last beforeDraw() did with the leader's frame.
+  [[nodiscard]] virtual LeaderFrameResult leaderFrameResult() const { return LeaderFrameResult::kNone; }
 };
 
 /// \brief Makes the player of an entry. Called off the frame loop's thread.

@@ -68,6 +68,12 @@ class TextureStream {
   /// \brief The number of the movie frame the last update() showed; -1 before the first, and
   /// for streams that are not movies.
   [[nodiscard]] virtual std::int64_t shownFrame() const { return -1; }
+  /// \brief Frame-locked followers: the movie frame the leader's stream shows in the coming
+  /// frame (its shownFrame()), which update() shows exactly; -1: none given (the stream's own
+  /// timeline).
+  virtual void setLeaderFrame(std::int64_t frame) { (void)frame; }
+  /// \brief What the last update() did with the leader's frame.
+  [[nodiscard]] virtual LeaderFrameResult leaderFrameResult() const { return LeaderFrameResult::kNone; }
 };
 
 using StreamFactory = std::function<Result<std::unique_ptr<TextureStream>>(const MediaSpec& media, const Manifest& show,

@@ -129,14 +129,15 @@ std::string healthJson(const StatusSnapshot& s) {
         "\"clock_offset_us\": {}, \"delay_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"malformed\": {}, "
         "\"holding\": {}, \"holding_seconds\": {:.1f}, \"held_frame\": {}, \"leader_returned\": {}, "
         "\"watchdog_pings_holding\": {}, \"programme_changes\": {}, \"commands_applied\": {}, "
-        "\"commands_resent\": {}, \"commands_lost\": {}}},\n",
+        "\"commands_resent\": {}, \"commands_lost\": {}, \"movie_frames_corrected\": {}, "
+        "\"movie_frames_late\": {}}},\n",
         jsonString(l->leader ? "leader" : "follower"), jsonString(l->node), l->followers, l->followersKnown,
         l->barrierTimeouts, l->followersDropped, l->followersRejoined, l->lateAnswers, l->barrierWaitP50Ms,
         l->barrierWaitMaxMs, l->leaderPresent ? "true" : "false", l->leaderLost, l->framesDrawn, l->lastFrame,
         l->skipped, l->presentsMissed, l->maxSkewFrames, l->leader ? l->maxClockOffsetUs : l->clockOffsetUs,
         l->delayP50Ms, l->delayMaxMs, l->malformed, l->holding ? "true" : "false", l->holdingSeconds, l->heldFrame,
         l->leaderReturned, l->watchdogPingsHolding, l->programmeChanges, l->commandsApplied, l->commandsResent,
-        l->commandsLost);
+        l->commandsLost, l->movieFramesCorrected, l->movieFramesLate);
   }
   out += "  \"devices\": [";
   for (std::size_t i = 0; i < s.devices.size(); ++i) {
@@ -304,6 +305,11 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
     if (!l->leader) {
       lockMetric("basalt_lock_commands_lost_total", "counter",
                  "The leader's commands gone from its log before this node had them.", l->commandsLost);
+      lockMetric("basalt_lock_movie_frames_corrected_total", "counter",
+                 "Movie frames shown by the leader's number that this node's own timeline would not have picked.",
+                 l->movieFramesCorrected);
+      lockMetric("basalt_lock_movie_frames_late_total", "counter",
+                 "The leader's movie frames not decoded here in time (the frame before stayed).", l->movieFramesLate);
     }
   }
   metric("basalt_reloads_total", "counter", "Reloads asked for (SIGHUP or the control server).");

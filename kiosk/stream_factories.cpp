@@ -119,6 +119,7 @@ class MovieStream final : public TextureStream {
       : media_(std::move(media)), player_(std::move(player)), manualClock_(manualClock) {}
 
   bool update(Nanos showTime, render::TextureRegistry& textures, const std::string& name) override {
+    leaderResult_ = LeaderFrameResult::kNone;
     if (!started_) {
       started_ = true;
       if (auto r = player_->load(media_.file); !r) {
@@ -150,14 +151,23 @@ class MovieStream final : public TextureStream {
       const media::MovieState now = player_->state();
       if (!aligned_ && now != media::MovieState::kFailed && now != media::MovieState::kEmpty) return false;
     }
-    if (patience.count() > 0) player_->waitForFrameDue(showTime, patience);
-    FrameRef frame = player_->frameAt(showTime);
-    if (origin_ && frame && patience.count() > 0) {
-      // The frame a seek onto the group's timeline brought is due when the seek was asked for;
-      // a node that waited for it takes the frame due now as well, so that it shows what the
-      // others show in this very frame.
-      player_->waitForFrameDue(showTime, patience);
-      if (FrameRef newer = player_->frameAt(showTime)) frame = std::move(newer);
+    FrameRef frame;
+    if (origin_ && leaderFrame_ >= 0) {
+      // A follower shows the leader's frame by its number, not by its own decoder's timestamps
+      // (a loop of its can come out a fraction of a millisecond longer than the leader's).
+      media::NumberedFrame pick = player_->frameNumbered(leaderFrame_, showTime, patience);
+      frame = std::move(pick.frame);
+      leaderResult_ = leaderFrameResultOf(pick.outcome);
+    } else {
+      if (patience.count() > 0) player_->waitForFrameDue(showTime, patience);
+      frame = player_->frameAt(showTime);
+      if (origin_ && frame && patience.count() > 0) {
+        // The frame a seek onto the group's timeline brought is due when the seek was asked for;
+        // a node that waited for it takes the frame due now as well, so that it shows what the
+        // others show in this very frame.
+        player_->waitForFrameDue(showTime, patience);
+        if (FrameRef newer = player_->frameAt(showTime)) frame = std::move(newer);
+      }
     }
     const media::MovieState state = player_->state();
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) {
@@ -190,6 +200,8 @@ class MovieStream final : public TextureStream {
   }
 
   void setLeaderPass(Nanos pass) override { leaderPass_ = pass; }
+  void setLeaderFrame(std::int64_t frame) override { leaderFrame_ = frame; }
+  [[nodiscard]] LeaderFrameResult leaderFrameResult() const override { return leaderResult_; }
   [[nodiscard]] Nanos passDuration() const override { return started_ ? player_->passDuration() : Nanos{0}; }
 
   [[nodiscard]] std::int64_t shownFrame() const override {
@@ -246,6 +258,8 @@ class MovieStream final : public TextureStream {
   std::chrono::milliseconds patience_{0};  // frame-locked follower: how long to wait for a frame
   bool aligned_ = false;                   // the seek onto the group's timeline is asked for
   Nanos leaderPass_{0};                    // frame-locked follower: the leader's pass of this loop (0: unknown)
+  std::int64_t leaderFrame_ = -1;          // frame-locked follower: the leader's movie frame in the coming frame
+  LeaderFrameResult leaderResult_ = LeaderFrameResult::kNone;
   bool started_ = false;
   bool reportedFailure_ = false;
   std::string failure_;

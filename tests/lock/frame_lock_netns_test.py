@@ -169,18 +169,24 @@ def check_movie(label, kind, leader_log, follower_logs, paced):
         assert mine, f"{name} logged no movie frame:\n{open(log).read()[-3000:]}"
         common = sorted(set(mine) & set(lead))
         assert len(common) >= len(mine) * 0.95, f"{name}: {len(common)} of {len(mine)} frames also on the leader"
+        # The leader sends the movie frame it shows with every frame and a follower shows that
+        # frame by its number, so no frame may differ, paced or not (before, a follower whose
+        # loop came out a fraction of a millisecond longer showed the frame before the leader's
+        # at frames a hair from a movie frame boundary).
         differ = [(n, lead[n], mine[n]) for n in common if lead[n] != mine[n]]
-        # Paced, a node's loop can come out a fraction of a millisecond longer than another's (the
-        # player's loop arithmetic, ARCHITECTURE.md "Left to do"): the frames a hair from a frame
-        # boundary then differ by one, a few in a hundred. Never more, never by more than one.
-        allowed = 0 if not paced else len(common) * 0.05
-        off_by_more = [d for d in differ if min((d[1] - d[2]) % CLIP_FRAMES, (d[2] - d[1]) % CLIP_FRAMES) > 1]
-        assert len(differ) <= allowed and not off_by_more, (
+        assert not differ, (
             f"{name} drew other movie frames than the leader (frame, leader, {name}): "
             f"{differ[:10]} ({len(differ)} of {len(common)})")
-        agree = "all" if not differ else f"{len(common) - len(differ)} of the"
-        print(f"[{label}] {name}: movie frames agree with the leader's in {agree} {len(common)} locked frames "
-              f"{common[0]}..{common[-1]}" + (f"; differ by one in {differ[:5]}" if differ else ""))
+        print(f"[{label}] {name}: movie frames agree with the leader's in all {len(common)} locked frames "
+              f"{common[0]}..{common[-1]}")
+
+
+def movie_corrections(line):
+    """A follower's summary: movie frames shown by the leader's number that its own timeline would
+    not have picked, and those that came too late."""
+    m = re.search(r"(\d+) movie frames corrected to the leader's, (\d+) late", line)
+    assert m, line
+    return int(m.group(1)), int(m.group(2))
 
 
 def start(basalt, ns, show, *extra, tag):
@@ -269,6 +275,9 @@ def run_steady(basalt, work, frames, timeout_ms, label, strict=True, clip=None):
             assert f["drawn"] + f["skipped"] == frames, f
             assert f["drawn"] >= frames * 0.8, f
             assert f["skew"] <= 30, f
+        if clip:
+            corrected, late = movie_corrections(line)
+            print(f"[{label}] {name}: {corrected} movie frames corrected to the leader's, {late} late")
         worst_skew = max(worst_skew, f["skew"])
         worst_offset = max(worst_offset, f["maxoffset"])
     if clip:
@@ -316,6 +325,9 @@ def run_rejoin(basalt, work, clip=None):
     assert lf["dropped"] >= 1 and lf["rejoined"] >= 1 and lf["inbarrier"] == 2, lf
     print(f"[rejoin] the restarted follower came in at frame {bf['first']} and drew {bf['drawn']} frames to the end")
     if clip:
+        for name, line in (("a", aline), ("b (restarted)", b2line)):
+            corrected, late = movie_corrections(line)
+            print(f"[rejoin] {name}: {corrected} movie frames corrected to the leader's, {late} late")
         # The restarted follower's movie starts on the leader's timeline, not at its own start.
         check_movies("rejoin", llog, (("a", alog), ("b (restarted)", b2log)), paced=True)
 

@@ -672,6 +672,8 @@ TEST(FrameLockStatus, FiguresReachHealthAndMetrics) {
   follower.leaderPresent = true;
   follower.skipped = 4;
   follower.clockOffsetUs = -35;
+  follower.movieFramesCorrected = 12;
+  follower.movieFramesLate = 1;
   s.lock = follower;
   EXPECT_EQ(overallState(s), "ok");
   const std::string health = healthJson(s);
@@ -681,6 +683,10 @@ TEST(FrameLockStatus, FiguresReachHealthAndMetrics) {
   EXPECT_NE(metrics.find("basalt_lock_frames_skipped_total{node=\"north\",role=\"follower\"} 4"), std::string::npos)
       << metrics;
   EXPECT_NE(metrics.find("basalt_lock_clock_offset_us{node=\"north\",role=\"follower\"} -35"), std::string::npos);
+  EXPECT_NE(health.find("\"movie_frames_corrected\": 12, \"movie_frames_late\": 1"), std::string::npos) << health;
+  EXPECT_NE(metrics.find("basalt_lock_movie_frames_corrected_total{node=\"north\",role=\"follower\"} 12"),
+            std::string::npos);
+  EXPECT_NE(metrics.find("basalt_lock_movie_frames_late_total{node=\"north\",role=\"follower\"} 1"), std::string::npos);
 
   s.lock->leaderPresent = false;
   EXPECT_EQ(overallState(s), "degraded");
