@@ -36,14 +36,16 @@ struct HalfPlane {
   [[nodiscard]] float at(const Vec2& p) const { return a * p.x + b * p.y + c; }
 };
 
-/// The piece of the square -1..1 outside one half-plane (where it is below zero), clipped by
-/// Sutherland and Hodgman's rule: the four corners give at most five.
-std::size_t outsidePiece(const HalfPlane& h, std::array<Vec2, 5>& piece) {
-  static constexpr std::array<Vec2, 4> kSquare = {Vec2{-1, -1}, Vec2{1, -1}, Vec2{1, 1}, Vec2{-1, 1}};
+/// The piece of the rectangle `box` (x0, y0, x1, y1 in normalised device coordinates) outside
+/// one half-plane (where it is below zero), clipped by Sutherland and Hodgman's rule: the four
+/// corners give at most five.
+std::size_t outsidePiece(const HalfPlane& h, const std::array<float, 4>& box, std::array<Vec2, 5>& piece) {
+  const std::array<Vec2, 4> corners = {Vec2{box[0], box[1]}, Vec2{box[2], box[1]}, Vec2{box[2], box[3]},
+                                       Vec2{box[0], box[3]}};
   std::size_t n = 0;
-  for (std::size_t i = 0; i < kSquare.size(); ++i) {
-    const Vec2& p = kSquare[i];
-    const Vec2& q = kSquare[(i + 1) % kSquare.size()];
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    const Vec2& p = corners[i];
+    const Vec2& q = corners[(i + 1) % corners.size()];
     const float hp = h.at(p), hq = h.at(q);
     if (hp <= 0) piece[n++] = p;
     if ((hp < 0 && hq > 0) || (hp > 0 && hq < 0)) {
@@ -123,8 +125,21 @@ Result<std::unique_ptr<BorderMask>> BorderMask::create() {
   return mask;
 }
 
-void BorderMask::draw(std::span<const Vec2> polygon, const Viewport& viewport, const std::array<bool, 3>& colorMask) {
+void BorderMask::draw(std::span<const Vec2> polygon, const Viewport& viewport, const std::array<bool, 3>& colorMask,
+                      const Viewport& within) {
   if (viewport.width == 0 || viewport.height == 0) return;
+  // The rectangle the pieces cover, in normalised device coordinates: the viewport, or the part
+  // of it the caller says is not black yet.
+  std::array<float, 4> box = {-1, -1, 1, 1};
+  if (within.width > 0 && within.height > 0) {
+    const auto w = static_cast<float>(viewport.width), h = static_cast<float>(viewport.height);
+    box = {
+        std::max(-1.0f, static_cast<float>(within.x - viewport.x) / w * 2 - 1),
+        std::max(-1.0f, static_cast<float>(within.y - viewport.y) / h * 2 - 1),
+        std::min(1.0f, static_cast<float>(within.x - viewport.x + static_cast<std::int64_t>(within.width)) / w * 2 - 1),
+        std::min(1.0f,
+                 static_cast<float>(within.y - viewport.y + static_cast<std::int64_t>(within.height)) / h * 2 - 1)};
+  }
   Gpu& g = *gpu_;
   const std::size_t n = polygon.size() >= 3 && polygon.size() <= kMaxCorners ? polygon.size() : 0;
   // Signed area: the half-planes face the inside whichever way the outline runs (the rear
@@ -142,9 +157,9 @@ void BorderMask::draw(std::span<const Vec2> polygon, const Viewport& viewport, c
   // near the corners, so no pixel outside the outline can fall between two of them.
   const float onEdge = 0.125f / static_cast<float>(std::max(viewport.width, viewport.height));
   std::size_t floats = 0;
-  const auto addPiece = [&g, &floats](const HalfPlane& h) {
+  const auto addPiece = [&g, &floats, &box](const HalfPlane& h) {
     std::array<Vec2, 5> piece{};
-    const std::size_t corners = outsidePiece(h, piece);
+    const std::size_t corners = outsidePiece(h, box, piece);
     for (std::size_t k = 1; k + 1 < corners; ++k) {
       for (const Vec2& p : {piece[0], piece[k], piece[k + 1]}) {
         g.values[floats++] = p.x;
@@ -211,11 +226,18 @@ Result<void> FacetRenderer::draw(Renderer& renderer, const runtime::Show& show, 
     return {};
   }
   const Mat4 model = show.position().global * show.position().local * runtime::viewNormalisation(show);
+  // Outside its scissor a view leaves the clear colour: when that is black, the border need
+  // only cover the outline's box (the whole viewport otherwise, and for anaglyph eyes, whose
+  // channels share one clear).
+  const runtime::Color3 clear = Renderer::clearColor(show);
+  const bool clearIsBlack = clear.r <= 0 && clear.g <= 0 && clear.b <= 0;
   auto drawEye = [&](const runtime::FacetProjection& p, const ViewPass& viewPass) {
     runtime::ViewTransforms t{model, p.view, p.projection, p.eye};
     if (adjust) adjust(t);
     renderer.draw(show, t, viewPass);
-    mask_->draw(p.border, viewPass.viewport, viewPass.colorMask);
+    const bool boxOnly =
+        clearIsBlack && viewPass.drawBackground && !(pass.stereo && pass.stereoMode == runtime::StereoMode::kAnaglyph);
+    mask_->draw(p.border, viewPass.viewport, viewPass.colorMask, boxOnly ? viewPass.scissor : Viewport{});
   };
   if (!pass.stereo) {
     ViewPass viewPass;
@@ -243,8 +265,7 @@ Result<void> FacetRenderer::draw(Renderer& renderer, const runtime::Show& show, 
       viewPass.drawBackground = eye == 0;
       // The left eye clears the background for both: it covers both eyes' outlines.
       if (eye == 0 && shown[1]) {
-        viewPass.scissor = shown[0] ? boundsUnion(viewPass.scissor, outlineBounds(eyes_[1].border, vp))
-                                    : Viewport{};
+        viewPass.scissor = shown[0] ? boundsUnion(viewPass.scissor, outlineBounds(eyes_[1].border, vp)) : Viewport{};
       }
     }
     if (!shown[eye]) {

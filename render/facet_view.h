@@ -31,9 +31,10 @@ class BorderMask {
   BorderMask& operator=(const BorderMask&) = delete;
 
   /// \brief Draws the black border into the channels `colorMask` allows (an anaglyph eye's); a
-  /// polygon with fewer than 3 corners blackens the viewport.
+  /// polygon with fewer than 3 corners blackens the viewport. With `within` (window pixels) only
+  /// that part of the viewport is covered: the caller knows the rest is black already.
   void draw(std::span<const Vec2> polygon, const Viewport& viewport,
-            const std::array<bool, 3>& colorMask = {true, true, true});
+            const std::array<bool, 3>& colorMask = {true, true, true}, const Viewport& within = {});
 
  private:
   struct Gpu;

@@ -36,10 +36,10 @@ Viewport scissorRect(const Viewport& viewport, const Viewport& scissor) {
   if (scissor.width == 0 || scissor.height == 0) return viewport;
   const std::int64_t x0 = std::max<std::int64_t>(viewport.x, scissor.x);
   const std::int64_t y0 = std::max<std::int64_t>(viewport.y, scissor.y);
-  const std::int64_t x1 = std::min<std::int64_t>(std::int64_t{viewport.x} + viewport.width,
-                                                 std::int64_t{scissor.x} + scissor.width);
-  const std::int64_t y1 = std::min<std::int64_t>(std::int64_t{viewport.y} + viewport.height,
-                                                 std::int64_t{scissor.y} + scissor.height);
+  const std::int64_t x1 =
+      std::min<std::int64_t>(std::int64_t{viewport.x} + viewport.width, std::int64_t{scissor.x} + scissor.width);
+  const std::int64_t y1 =
+      std::min<std::int64_t>(std::int64_t{viewport.y} + viewport.height, std::int64_t{scissor.y} + scissor.height);
   if (x1 <= x0 || y1 <= y0) return {viewport.x, viewport.y, 0, 0};
   return {static_cast<std::int32_t>(x0), static_cast<std::int32_t>(y0), static_cast<std::uint32_t>(x1 - x0),
           static_cast<std::uint32_t>(y1 - y0)};
@@ -709,16 +709,19 @@ struct Renderer::Impl {
 
   // ---- Background, floor, shadow ----
 
-  void drawBackground(const Show& show, const runtime::ViewTransforms& view, const Mat4& projection) {
+  /// Clears the viewport to the background's clear colour, then draws an image, skybox or
+  /// earth-sky background inside `clip`.
+  void drawBackground(const Show& show, const runtime::ViewTransforms& view, const Mat4& projection,
+                      const Viewport& clip) {
     const runtime::BackgroundKind kind = show.backgroundKind();
     const runtime::EarthSky& sky = show.earthSky();
-    Color3 clear = show.global().background;
+    const Color3 clear = Renderer::clearColor(show);
     const bool earthSkyClearOnly =
         sky.mode == runtime::EarthSkyClear::kFast || sky.mode == runtime::EarthSkyClear::kTag;
-    if (kind == runtime::BackgroundKind::kEarthSky && earthSkyClearOnly) clear = sky.clear;
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClearColor(clear.r, clear.g, clear.b, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT);
+    glScissor(clip.x, clip.y, static_cast<GLsizei>(clip.width), static_cast<GLsizei>(clip.height));
 
     int mode = 0;
     const TextureView* image = nullptr;
@@ -895,12 +898,14 @@ struct Renderer::Impl {
     glDisable(GL_BLEND);
     glDisable(GL_POLYGON_OFFSET_FILL);
     glDepthMask(GL_TRUE);
-    if (pass.drawBackground) drawBackground(show, view, projection);
+    // The clears cover the whole viewport (a scissored clear is a drawn quad on Mesa, slower
+    // than a whole one); what is drawn after them stays inside the pass's scissor.
     if (pass.clearDepth) {
       glClearDepthf(1.0f);
       glClearStencil(0);
       glClear(GL_DEPTH_BUFFER_BIT | (self.caps_.stencil ? GL_STENCIL_BUFFER_BIT : 0));
     }
+    if (pass.drawBackground) drawBackground(show, view, projection, clip);
     setColorMask(true);
     glScissor(clip.x, clip.y, static_cast<GLsizei>(clip.width), static_cast<GLsizei>(clip.height));
     drawFloor(show);
@@ -1022,6 +1027,13 @@ void Renderer::draw(const Show& show, const runtime::ViewTransforms& view, const
   frameCounts_.points += counts_.points;
   frameCounts_.parts += counts_.parts;
   frameCounts_.facets += counts_.facets;
+}
+
+runtime::Color3 Renderer::clearColor(const Show& show) {
+  const runtime::EarthSky& sky = show.earthSky();
+  const bool earthSkyClearOnly = sky.mode == runtime::EarthSkyClear::kFast || sky.mode == runtime::EarthSkyClear::kTag;
+  return show.backgroundKind() == runtime::BackgroundKind::kEarthSky && earthSkyClearOnly ? sky.clear
+                                                                                          : show.global().background;
 }
 
 void Renderer::drawShow(const Show& show, const Viewport& viewport,

@@ -51,8 +51,9 @@ struct ViewPass {
   /// the anaglyph's left eye writes red only, the right eye green and blue.
   std::array<bool, 3> colorMask{true, true, true};
   Vec2 jitter{0, 0};  ///< sub-pixel offset of the whole view, in pixels (stochastic passes)
-  /// Where in the viewport the view may write, in window pixels (a facet's bounding box: the
-  /// border covers the rest); empty: the whole viewport.
+  /// Where in the viewport the view may draw, in window pixels (a facet's bounding box: the
+  /// border covers the rest); empty: the whole viewport. The clears still cover the whole
+  /// viewport, so outside it the view leaves the background's clear colour (Renderer::clearColor).
   Viewport scissor;
 };
 
@@ -117,6 +118,9 @@ class Renderer {
 
   /// \brief LAVA's eight jitter offsets, in pixels (-0.5..0.5), in the order passes use them.
   static const std::array<Vec2, 8>& jitterOffsets();
+  /// \brief The colour a view of `show` is cleared to before anything is drawn: the background
+  /// colour, or the earth-sky's clear colour when it only clears.
+  [[nodiscard]] static runtime::Color3 clearColor(const runtime::Show& show);
 
  private:
   struct Impl;

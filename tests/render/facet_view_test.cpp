@@ -134,6 +134,31 @@ TEST_F(FacetViews, EverythingOutsideTheFacetIsBlackForEveryThesisShape) {
   }
 }
 
+TEST_F(FacetViews, OverABlackClearTheBorderCoversOnlyTheOutlinesBoxAndNothingShowsOutside) {
+  // A view whose clear colour is black draws its background and scene only inside the outline's
+  // bounding box, and the border then covers only that box (the clear left the rest black). An
+  // earth-sky (sky and ground, no black in it) drawn over a black clear shows whether anything
+  // leaks outside, or the border misses a corner inside the box.
+  Show show = Show::makeDefault();
+  show.backgroundKind() = runtime::BackgroundKind::kEarthSky;
+  show.earthSky().mode = runtime::EarthSkyClear::kSkyGround;
+  ASSERT_EQ(render::Renderer::clearColor(show).r, 0.0f);
+  for (const std::string& obj : {cubeDisplayObj(), prismDisplayObj(), icositetrahedronDisplayObj()}) {
+    const formats::CaveGeometry g = geometryOf(obj);
+    for (std::size_t i = 0; i < g.facets.size(); i += 3) {
+      const Image image = drawFacet(show, g.facets[i]);
+      expectBorder(image, facets_->lastProjection().border, fmt::format("facet {} of {}", i, g.facets.size()));
+    }
+  }
+  // Side by side: each eye's box in its own half.
+  const formats::CaveGeometry prism = geometryOf(prismDisplayObj());
+  const Image pair = drawFacet(show, prism.facets[6], true, runtime::StereoMode::kSideBySide);
+  EXPECT_NE(pair.at(kRenderSize / 4, kRenderSize / 2, 2), 0) << "the left eye's sky";
+  EXPECT_NE(pair.at(kRenderSize * 3 / 4, kRenderSize / 2, 2), 0) << "the right eye's sky";
+  EXPECT_EQ(pair.at(1, 1, 2), 0) << "outside the left eye's facet";
+  EXPECT_EQ(pair.at(kRenderSize - 2, 1, 2), 0) << "outside the right eye's facet";
+}
+
 TEST_F(FacetViews, GoldenFacetViewsWithTheBorder) {
   const Show show = greyShow();
   // The cube's -Z wall looks at the default show's cube, as the plain view does (mirrored for
