@@ -97,6 +97,7 @@ struct FrameLock::Impl {
   const LockClockProbe* probe = nullptr;
   std::function<void(const FrameLockFigures&)> publish;
   LockedDirector* director = nullptr;
+  std::vector<LockedMovies*> movies;             // borrowed (addMovies): a script's VCR, --movie streams
   std::optional<LockedProgramme> lastProgramme;  // the programme last sent (leader) or followed (follower)
   Nanos lostAt{-1};                              // wall time the leader was reported lost
   Nanos lastPublished{-1};
@@ -222,6 +223,8 @@ struct FrameLock::Impl {
       noteProgramme(m.frame, m.programme, "sends");
       if (const LockCommandLog* commands = director->commandLog()) announceCommands(*commands, m.command);
     }
+    // The run's other movies write their own slots (after the director's: theirs win).
+    for (const LockedMovies* other : movies) other->lockedMovieFrames(m.movies);
     send(pub.get(), encode(m, buffer));
   }
 
@@ -448,9 +451,11 @@ struct FrameLock::Impl {
         if (director && f.programme.present) {
           if (director->followProgramme(f.programme, Nanos{f.showTimeNs}))
             noteProgramme(f.frame, f.programme, "follows");
-          // The movie frames the leader shows in this frame: the follower's movies show them.
-          director->followMovieFrames(f.movies);
+          // The movie frames the leader shows in this frame: the follower's movies show them
+          // (the director's, less the slots the run's other movies use).
+          director->followMovieFrames(directorMovies(f.movies));
         }
+        for (LockedMovies* other : movies) other->followMovieFrames(f.movies);
         // Then the leader's script commands, in order: those it ran in this frame act in it on
         // every node (after the programme, which may have reset the show, as on the leader).
         if (director && f.programme.present) {
@@ -577,13 +582,32 @@ struct FrameLock::Impl {
     send(answers.get(), encode(ResendMessage{*commandEpoch, from}, buffer));
   }
 
-  void beforeDrawFollower() {
-    if (director) {
-      // The director drew its movies before this (the lock is the last participant).
-      const LockedMovieCounts movies = director->movieFrameCounts();
-      figures.movieFramesCorrected = movies.corrected;
-      figures.movieFramesLate = movies.late;
+  /// The leader's movie frames without the slots the run's other movies use (-1 there), which
+  /// the director must not take for its own movies.
+  [[nodiscard]] LockedMovieFrames directorMovies(const LockedMovieFrames& frames) const {
+    if (movies.empty()) return frames;
+    constexpr std::int32_t kUnused = -2;  // no movie writes it: a slot still holding it is free
+    LockedMovieFrames used{kUnused, {kUnused, kUnused, kUnused, kUnused}};
+    for (const LockedMovies* other : movies) other->lockedMovieFrames(used);
+    LockedMovieFrames mine = frames;
+    if (used.item != kUnused) mine.item = -1;
+    for (std::size_t i = 0; i < mine.textures.size(); ++i) {
+      if (used.textures[i] != kUnused) mine.textures[i] = -1;
     }
+    return mine;
+  }
+
+  void beforeDrawFollower() {
+    // The movies were drawn before this (the lock is the last participant).
+    LockedMovieCounts counts;
+    if (director) counts = director->movieFrameCounts();
+    for (const LockedMovies* other : movies) {
+      const LockedMovieCounts c = other->movieFrameCounts();
+      counts.corrected += c.corrected;
+      counts.late += c.late;
+    }
+    figures.movieFramesCorrected = counts.corrected;
+    figures.movieFramesLate = counts.late;
     if (!pending) return;
     applyLockedState(pending->state, show);
     pending.reset();
@@ -678,6 +702,8 @@ void FrameLock::setPublisher(std::function<void(const FrameLockFigures&)> publis
 }
 
 void FrameLock::setDirector(LockedDirector* director) { impl_->director = director; }
+
+void FrameLock::addMovies(LockedMovies& movies) { impl_->movies.push_back(&movies); }
 
 void FrameLock::afterPresent(const FrameContext& frame) {
   (void)frame;

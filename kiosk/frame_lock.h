@@ -80,6 +80,23 @@ class LockedDirector {
   }
 };
 
+/// \brief Movies of a run that no director plays (a LAVA script's VCR, `basalt run --movie`
+/// streams), shown by the leader's frame number on followers as the director's are. Each uses
+/// fixed slots of LockedMovieFrames (the same on every node: the same show and command line).
+class LockedMovies {
+ public:
+  virtual ~LockedMovies() = default;
+  /// \brief Leader: writes the movie frame each of its movies shows in this frame into every slot
+  /// it uses, -1 for none (called in the lock's beforeDraw, after the director's). Also called
+  /// on a follower, to learn which slots these movies use.
+  virtual void lockedMovieFrames(LockedMovieFrames& frames) const = 0;
+  /// \brief Follower: the leader's movie frames for the frame about to be drawn (called by the
+  /// gate before any participant's beforeDraw): its movies show exactly these.
+  virtual void followMovieFrames(const LockedMovieFrames& frames) = 0;
+  /// \brief Follower: its movies' frames shown by the leader's number so far.
+  [[nodiscard]] virtual LockedMovieCounts movieFrameCounts() const = 0;
+};
+
 /// \brief One node of a frame-locked group: a FrameParticipant on both roles (add it last, so
 /// that it sees the frame's final state), and the FrameGate of a follower's loop.
 ///
@@ -112,6 +129,10 @@ class FrameLock final : public FrameParticipant, public FrameGate {
   /// \brief The director whose programme the leader sends and a follower follows; borrowed, null
   /// for none (a script run: followers then keep their own).
   void setDirector(LockedDirector* director);
+  /// \brief Movies besides the director's whose frames the leader sends and a follower shows by
+  /// number (a script's VCR, `--movie` streams); borrowed, must outlive the lock. Their slots
+  /// take precedence over the director's, which a follower then gives -1 there.
+  void addMovies(LockedMovies& movies);
 
   Result<void> beforeDraw(const FrameContext& frame) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;

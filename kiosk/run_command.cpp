@@ -735,8 +735,19 @@ int runShow(const RunOptions& options) {
     // Movies on the group's timeline. A follower waits (bounded) for the movie frame the leader
     // draws; the leader waits briefly too, so that a decoder a little late does not part its
     // picture from the followers'.
-    director.setLocked(lock->leader(), std::chrono::milliseconds(lock->leader() ? std::min(spec.timeoutMs, 50)
-                                                                                : std::min(spec.leaderTimeoutMs, 500)));
+    const std::chrono::milliseconds patience(lock->leader() ? std::min(spec.timeoutMs, 50)
+                                                            : std::min(spec.leaderTimeoutMs, 500));
+    director.setLocked(lock->leader(), patience);
+    // The script's VCR and the --movie streams, which no director plays, are shown by the
+    // leader's frame number too (leaders keep their own timeline).
+    if (player) {
+      lock->addMovies(*player);
+      if (!lock->leader()) player->followLeader(patience);
+    }
+    if (videos) {
+      lock->addMovies(*videos);
+      if (!lock->leader()) videos->followLeader(patience);
+    }
     lock->setPublisher([&board, &director, supervision = supervisor.get(), holding = false,
                         leaderAt = spec.leader](const FrameLockFigures& figures) mutable {
       FrameLockFigures f = figures;

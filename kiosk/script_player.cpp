@@ -14,6 +14,8 @@
 #include <cctype>
 #include <cstdio>
 #include <fstream>
+#include <limits>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/std.h>
@@ -27,6 +29,7 @@
 namespace basalt::kiosk {
 
 BASALT_LOG_CATEGORY(ScriptPlayer, "script");
+BASALT_LOG_CATEGORY(Kiosk, "kiosk");  // the movie frame each frame shows, as the director logs its own
 
 using script::Feature;
 using script::StepStop;
@@ -136,7 +139,7 @@ void ScriptPlayer::runStep() {
 }
 
 Result<void> ScriptPlayer::beforeDraw(const FrameContext& frame) {
-  updateVideo(frame.time, options_.manualClock);
+  updateVideo(frame, options_.manualClock);
   if (!started_) {
     // Frame 0 shows what the script set up to its first draw.
     started_ = true;
@@ -322,7 +325,34 @@ Result<void> ScriptPlayer::vcrCommand(const script::TvRequest& request) {
   return {};
 }
 
-void ScriptPlayer::updateVideo(Nanos showTime, bool manualClock) {
+void ScriptPlayer::lockedMovieFrames(LockedMovieFrames& frames) const {
+  const std::int64_t shown = vcr_ && vcrLoaded_ && videoLive_ && !camera_ ? vcr_->currentFrame() : -1;
+  frames.item = shown >= 0 && shown <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(shown) : -1;
+}
+
+void ScriptPlayer::followMovieFrames(const LockedMovieFrames& frames) { leaderFrame_ = frames.item; }
+
+void ScriptPlayer::followLeader(std::chrono::milliseconds patience) {
+  follower_ = true;
+  patience_ = patience;
+}
+
+FrameRef ScriptPlayer::vcrFrame(Nanos showTime, bool manualClock) {
+  const std::int64_t leader = std::exchange(leaderFrame_, -1);  // used up: the next frame brings its own
+  if (follower_ && leader >= 0) {
+    // The leader's frame by its number: two decoders' timestamps need not add up alike.
+    const std::chrono::milliseconds patience = manualClock ? std::chrono::milliseconds(10000) : patience_;
+    media::NumberedFrame pick = vcr_->frameNumbered(leader, showTime, patience);
+    if (pick.outcome == media::NumberedOutcome::kCorrected) ++movieCounts_.corrected;
+    if (pick.outcome == media::NumberedOutcome::kLate) ++movieCounts_.late;
+    return std::move(pick.frame);
+  }
+  if (manualClock) vcr_->waitForFrameDue(showTime, std::chrono::seconds(10));
+  return vcr_->frameAt(showTime);
+}
+
+void ScriptPlayer::updateVideo(const FrameContext& frameContext, bool manualClock) {
+  const Nanos showTime = frameContext.time;
   const std::string name(kScriptVideoTexture);
   bool live = false;
   if (camera_) {
@@ -339,8 +369,7 @@ void ScriptPlayer::updateVideo(Nanos showTime, bool manualClock) {
       }
       video_ = std::move(*texture);
     }
-    if (manualClock) vcr_->waitForFrameDue(showTime, std::chrono::seconds(10));
-    const FrameRef frame = vcr_->frameAt(showTime);
+    const FrameRef frame = vcrFrame(showTime, manualClock);
     auto changed = video_->update(frame);
     if (!changed) {
       warn(fmt::format("the movie cannot be shown: {}; it is unloaded", changed.error().describe()));
@@ -349,6 +378,12 @@ void ScriptPlayer::updateVideo(Nanos showTime, bool manualClock) {
     } else if (!video_->showingFallback()) {
       video_->publish(renderer_.textures());
       live = true;
+      // Which movie frame the VCR shows in which frame (BASALT_LOG=kiosk=debug): frame-locked
+      // nodes are compared with it.
+      if (const std::int64_t shown = vcr_->currentFrame(); shown >= 0 && kLogKiosk.enabled(log::Level::kDebug)) {
+        log::debug(kLogKiosk, "frame {}: texture '{}' shows movie '{}' frame {}", frameContext.frame, name,
+                   vcr_->info().path.filename().string(), shown);
+      }
     }
   }
   if (!live && videoLive_) {

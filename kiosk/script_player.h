@@ -10,6 +10,7 @@
 /// `draw`. So `save_image` and `end_jitter` read exactly the picture the script drew last, and a
 /// `quit` makes the frame just drawn the last one.
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "kiosk/frame_lock.h"
 #include "kiosk/frame_loop.h"
 #include "kiosk/show_loader.h"
 #include "media/movie_player.h"
@@ -44,7 +46,11 @@ struct ScriptPlayerOptions {
 ///
 /// Threading: the frame loop's thread, with the GL context current (textures are uploaded and
 /// the framebuffer read back here).
-class ScriptPlayer final : public FrameParticipant, public script::Host {
+///
+/// Frame-locked (LockedMovies): the VCR's movie uses the item slot of LockedMovieFrames. A
+/// leader sends the frame its VCR shows; a follower shows exactly the leader's frame
+/// (MoviePlayer::frameNumbered), whatever its own timestamps say.
+class ScriptPlayer final : public FrameParticipant, public script::Host, public LockedMovies {
  public:
   ScriptPlayer(script::Interpreter interpreter, runtime::Show& show, render::Renderer& renderer,
                ScriptPlayerOptions options);
@@ -61,6 +67,14 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
   void adjustView(const FrameContext& frame, runtime::ViewTransforms& view, render::Size size) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
   [[nodiscard]] bool wantsStop() const override { return stop_; }
+
+  // LockedMovies
+  void lockedMovieFrames(LockedMovieFrames& frames) const override;
+  void followMovieFrames(const LockedMovieFrames& frames) override;
+  [[nodiscard]] LockedMovieCounts movieFrameCounts() const override { return movieCounts_; }
+  /// \brief Frame-locked follower: the VCR shows the leader's movie frames, waiting up to
+  /// `patience` for one not decoded yet (ten seconds on a manual clock).
+  void followLeader(std::chrono::milliseconds patience);
 
   // script::Host
   [[nodiscard]] Result<void> loadObject(const std::filesystem::path& file, runtime::Show& show) override;
@@ -86,7 +100,9 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
   Result<void> presentPicture(const Image& image);
   void warn(std::string message);
   Result<void> vcrCommand(const script::TvRequest& request);
-  void updateVideo(Nanos showTime, bool manualClock);
+  void updateVideo(const FrameContext& frame, bool manualClock);
+  /// The VCR's frame for this frame: the leader's by number on a follower, else by the timeline.
+  FrameRef vcrFrame(Nanos showTime, bool manualClock);
 
   script::Interpreter interpreter_;
   runtime::Show& show_;
@@ -111,6 +127,11 @@ class ScriptPlayer final : public FrameParticipant, public script::Host {
   std::unique_ptr<TextureStream> camera_;
   std::unique_ptr<render::StreamTexture> video_;
   bool videoLive_ = false;
+  // Frame-locked follower (followLeader): the leader's VCR frame in the coming frame, -1 for none.
+  bool follower_ = false;
+  std::chrono::milliseconds patience_{0};
+  std::int64_t leaderFrame_ = -1;
+  LockedMovieCounts movieCounts_;
 };
 
 /// \brief Whether `path` names a LAVA script (.mdl, any case).

@@ -1,7 +1,10 @@
 #include "kiosk/video_streams.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include <fmt/format.h>
 #include <fmt/std.h>
@@ -62,7 +65,16 @@ struct VideoStreams::Stream {
   media::MovieState lastState = media::MovieState::kEmpty;
   render::PictureRect zoomRect{};
   bool zoomPlaced = false;
+  std::int64_t leaderFrame = -1;  // frame-locked follower: the leader's frame in the coming frame
+  bool shows = false;             // a frame of the movie is on the texture (not the fallback)
 };
+
+namespace {
+/// The slot of LockedMovieFrames::textures that stream `index` uses, or -1 beyond them.
+int lockedSlot(std::size_t index, std::size_t slots) {
+  return index < slots ? static_cast<int>(slots - 1 - index) : -1;
+}
+}  // namespace
 
 VideoStreams::VideoStreams(render::Renderer& renderer, bool manualClock)
     : renderer_(renderer), manualClock_(manualClock) {}
@@ -138,13 +150,24 @@ Result<void> VideoStreams::beforeDraw(const FrameContext& frame) {
   }
   for (const auto& s : streams_) {
     media::MoviePlayer& player = *s->player;
-    if (manualClock_) player.waitForFrameDue(frame.time, std::chrono::seconds(10));
-    const FrameRef f = player.frameAt(frame.time);
+    FrameRef f;
+    if (const std::int64_t leader = std::exchange(s->leaderFrame, -1); follower_ && leader >= 0) {
+      // The leader's frame by its number: two decoders' timestamps need not add up alike.
+      const std::chrono::milliseconds patience = manualClock_ ? std::chrono::milliseconds(10000) : patience_;
+      media::NumberedFrame pick = player.frameNumbered(leader, frame.time, patience);
+      if (pick.outcome == media::NumberedOutcome::kCorrected) ++movieCounts_.corrected;
+      if (pick.outcome == media::NumberedOutcome::kLate) ++movieCounts_.late;
+      f = std::move(pick.frame);
+    } else {
+      if (manualClock_) player.waitForFrameDue(frame.time, std::chrono::seconds(10));
+      f = player.frameAt(frame.time);
+    }
     const media::MovieState state = player.state();
     if (state != s->lastState) {
       s->lastState = state;
       if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) s->texture->showFallback();
     }
+    s->shows = false;
     if (state == media::MovieState::kFailed) continue;
     // A part that takes up a picture-only stream's texture (a script's texture command) gets it
     // converted from then on.
@@ -157,8 +180,40 @@ Result<void> VideoStreams::beforeDraw(const FrameContext& frame) {
       s->lastState = media::MovieState::kEmpty;
     }
     s->texture->publish(renderer_.textures());
+    s->shows = changed && !s->texture->showingFallback();
+    // Which movie frame each stream shows in which frame (BASALT_LOG=kiosk=debug): frame-locked
+    // nodes are compared with it.
+    if (const std::int64_t shown = player.currentFrame(); s->shows && shown >= 0 && !s->spec.files.empty()) {
+      log::debug(kLogKiosk, "frame {}: texture '{}' shows movie '{}' frame {}", frame.frame, s->spec.name,
+                 s->spec.files[std::min(player.currentClip(), s->spec.files.size() - 1)].filename().string(), shown);
+    }
   }
   return {};
+}
+
+void VideoStreams::lockedMovieFrames(LockedMovieFrames& frames) const {
+  for (std::size_t i = 0; i < streams_.size(); ++i) {
+    const int slot = lockedSlot(i, frames.textures.size());
+    if (slot < 0) break;
+    const Stream& s = *streams_[i];
+    // A playlist's frames are numbered in their clip: it keeps to its own timeline (-1).
+    const std::int64_t shown = s.shows && s.spec.files.size() == 1 ? s.player->currentFrame() : -1;
+    frames.textures[static_cast<std::size_t>(slot)] =
+        shown >= 0 && shown <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(shown) : -1;
+  }
+}
+
+void VideoStreams::followMovieFrames(const LockedMovieFrames& frames) {
+  for (std::size_t i = 0; i < streams_.size(); ++i) {
+    const int slot = lockedSlot(i, frames.textures.size());
+    if (slot < 0) break;
+    streams_[i]->leaderFrame = frames.textures[static_cast<std::size_t>(slot)];
+  }
+}
+
+void VideoStreams::followLeader(std::chrono::milliseconds patience) {
+  follower_ = true;
+  patience_ = patience;
 }
 
 Result<void> VideoStreams::afterDraw(const FrameContext&, render::Output& output) {

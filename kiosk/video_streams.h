@@ -7,6 +7,8 @@
 /// manifest (issue 9) builds the same MovieStreamSpecs; `basalt run --movie/--zoom/--record`
 /// builds them from the command line until then.
 
+#include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -14,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "kiosk/frame_lock.h"
 #include "kiosk/frame_loop.h"
 #include "media/movie_player.h"
 #include "media/recorder.h"
@@ -49,7 +52,12 @@ struct MovieStreamSpec {
 /// \brief Movie streams taking part in every frame: each picks its newest due frame (never
 /// blocking on a system clock; waiting for the decoder under a manual clock so that an offline
 /// run is exact), converts it on the GPU and draws the Zoom pictures over the scene.
-class VideoStreams final : public FrameParticipant {
+///
+/// Frame-locked (LockedMovies): the streams use the last texture slots of LockedMovieFrames,
+/// the first stream the last slot (the show's own movie streams take the first slots; a
+/// stream beyond the four, and a playlist, keeps its own timeline). A leader sends the frame
+/// each shows; a follower shows exactly the leader's (MoviePlayer::frameNumbered).
+class VideoStreams final : public FrameParticipant, public LockedMovies {
  public:
   /// \brief Starts the players (GStreamer starts here, only for shows with movies). A file
   /// that cannot be played is reported, its part shows the fallback, and the show goes on.
@@ -62,6 +70,14 @@ class VideoStreams final : public FrameParticipant {
 
   Result<void> beforeDraw(const FrameContext& frame) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
+
+  // LockedMovies
+  void lockedMovieFrames(LockedMovieFrames& frames) const override;
+  void followMovieFrames(const LockedMovieFrames& frames) override;
+  [[nodiscard]] LockedMovieCounts movieFrameCounts() const override { return movieCounts_; }
+  /// \brief Frame-locked follower: the streams show the leader's movie frames, waiting up to
+  /// `patience` for one not decoded yet (ten seconds on a manual clock).
+  void followLeader(std::chrono::milliseconds patience);
 
   /// \brief The player of stream `name` (the VCR remote), or null.
   [[nodiscard]] media::MoviePlayer* player(std::string_view name);
@@ -85,6 +101,10 @@ class VideoStreams final : public FrameParticipant {
   std::vector<std::unique_ptr<Stream>> streams_;
   std::unique_ptr<render::PictureOverlay> overlay_;
   runtime::Bindings* zoomDials_ = nullptr;
+  // Frame-locked follower (followLeader): each stream's leaderFrame is set by followMovieFrames.
+  bool follower_ = false;
+  std::chrono::milliseconds patience_{0};
+  LockedMovieCounts movieCounts_;
 };
 
 /// \brief Records the rendered output (LAVA's Rec): reads each frame back after drawing and
