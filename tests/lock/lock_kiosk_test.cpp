@@ -7,7 +7,9 @@
 // Example failures: the follower switching a frame after the leader; a holding follower whose
 // watchdog goes quiet (systemd would kill every follower while the leader is down); a lost
 // leader the status page calls ok. A script command sent to the leader runs on the follower in
-// the same frame, and the follower refuses one of its own.
+// the same frame, and the follower refuses one of its own. A movie that no director plays
+// (`basalt run --movie`) shows the leader's movie frame on a follower that joined late, though its
+// own timeline started later: no locked frame shows another movie frame than the leader's.
 
 #include <gtest/gtest.h>
 
@@ -21,6 +23,7 @@
 #include <chrono>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <regex>
 #include <string>
@@ -31,6 +34,7 @@
 #include "media/image_io.h"
 #include "render/kiosk_process.h"
 #include "support/datagram_socket.h"
+#include "support/numbered_clip.h"
 #include "support/test_paths.h"
 
 namespace basalt {
@@ -316,6 +320,92 @@ TEST(LockedKiosk, AFollowerHoldingForALostLeaderKeepsPingingTheWatchdog) {
   const auto fr = follower->process().wait(20s);
   EXPECT_NE(fr.output.find("the leader is back after"), std::string::npos) << fr.output;
   (void)again->process().wait(20s);
+}
+
+/// {locked frame: movie frame} that texture `texture` showed, from a node's debug output
+/// ("frame N: texture 'T' shows movie 'M' frame K", BASALT_LOG=kiosk=debug).
+std::map<long, long> movieFrames(const std::string& output, const std::string& texture) {
+  const std::regex line("frame (\\d+): texture '" + texture + "' shows movie '[^']*' frame (\\d+)");
+  std::map<long, long> frames;
+  for (auto it = std::sregex_iterator(output.begin(), output.end(), line); it != std::sregex_iterator(); ++it) {
+    frames[std::stol((*it)[1].str())] = std::stol((*it)[2].str());
+  }
+  return frames;
+}
+
+std::string movieManifest(const std::string& lock) {
+  return R"(
+[show]
+name = "Locked movies"
+fps = 60
+
+[output]
+kind = "headless"
+size = "64x48"
+
+[status]
+listen = "127.0.0.1:0"
+
+[lock]
+)" + lock;
+}
+
+// Makes sure the movies `basalt run --movie` adds (VideoStreams, no director's) are frame-locked
+// by number: the leader sends the frame each shows, and a follower that joined 1.5 s late, whose
+// own movie timeline starts at its first frame, shows the leader's frame in every locked frame.
+// Example failure: the follower's stream plays on its own timestamps (about 20 movie frames
+// behind the leader's here, in every frame).
+TEST(LockedKiosk, AFollowerShowsTheLeadersMovieFramesOfAMovieOption) {
+  REQUIRE_EGL();
+  const int port = lockPort(3);
+  const auto leaderDir = test::writeShow(
+      "lock-kiosk-movie-leader", movieManifest("role = \"leader\"\nnode = \"leader\"\nlisten = \"127.0.0.1\"\nport = " +
+                                               std::to_string(port) + "\nfollowers = 0\ntimeout_ms = 500\n"));
+  const auto followerDir = test::writeShow("lock-kiosk-movie-follower", movieManifest(followerLock(port, 3000)));
+  auto clip = test::makeNumberedClip(leaderDir / "numbers.mkv", 30, 30, media::VideoCodec::kH264);
+  ASSERT_TRUE(clip) << clip.error().describe();
+  const std::string movie = "screen=" + clip->string();
+  const std::map<std::string, std::string> debug{{"BASALT_LOG", "kiosk=debug"}};
+  std::string why;
+  // 600 frames at 60 Hz: 10 s, the follower in for the last 8 or so.
+  auto leader = test::RunningShow::start(
+      {(leaderDir / "show.toml").string(), "--movie", movie, "--frames", "600", "--realtime", "--no-resume"}, debug,
+      why);
+  ASSERT_TRUE(leader) << why;
+  ASSERT_TRUE(leader->process().waitForOutput("shows movie", 20s)) << leader->process().outputSoFar();
+  std::this_thread::sleep_for(1500ms);
+  auto follower =
+      test::RunningShow::start({(followerDir / "show.toml").string(), "--movie", movie, "--no-resume"}, debug, why);
+  ASSERT_TRUE(follower) << why;
+  const auto lr = leader->process().wait(60s);
+  const auto fr = follower->process().wait(30s);
+  ASSERT_EQ(lr.exitCode, 0) << lr.output;
+  ASSERT_EQ(fr.exitCode, 0) << fr.output;
+
+  const std::map<long, long> lead = movieFrames(lr.output, "screen");
+  const std::map<long, long> mine = movieFrames(fr.output, "screen");
+  ASSERT_FALSE(lead.empty()) << lr.output.substr(0, 3000);
+  ASSERT_GE(mine.size(), 120u) << "the follower showed the movie in too few frames:\n" << fr.output.substr(0, 3000);
+  EXPECT_GT(mine.begin()->first, lead.begin()->first + 30) << "the follower was meant to join late";
+  std::size_t common = 0;
+  std::vector<std::string> differ;
+  for (const auto& [frame, shown] : mine) {
+    const auto it = lead.find(frame);
+    if (it == lead.end()) continue;
+    ++common;
+    if (it->second != shown) differ.push_back(fmt::format("{}: {} vs {}", frame, it->second, shown));
+  }
+  EXPECT_GE(common, mine.size() * 95 / 100) << "the follower's locked frames are the leader's";
+  EXPECT_TRUE(differ.empty()) << differ.size() << " of " << common
+                              << " locked frames showed another movie frame than the leader's (frame: leader vs "
+                                 "follower), first: "
+                              << differ.front();
+  const std::regex counts("(\\d+) movie frames corrected to the leader's, (\\d+) late");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(fr.output, m, counts))
+      << fr.output.substr(fr.output.size() > 3000 ? fr.output.size() - 3000 : 0);
+  // Its own timeline started later than the leader's: the leader's number corrected it.
+  EXPECT_GT(std::stol(m[1].str()), 0) << m[0].str();
 }
 
 }  // namespace

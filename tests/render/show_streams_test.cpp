@@ -47,6 +47,7 @@
 #include "sim/replay.h"
 #include "sim/synthetic_camera.h"
 #include "sim/trace.h"
+#include "support/numbered_clip.h"
 #include "support/test_paths.h"
 
 namespace basalt::kiosk {
@@ -355,6 +356,76 @@ TEST(ShowStreams, TheScriptVcrDrivesARealClip) {
   EXPECT_GE(at[15], at[13] + 10) << "fast_forward does not go ten frames on";
   EXPECT_LE(at[17], 1) << "rewind does not go back to the start";
   EXPECT_FALSE(live.back()) << "after unload the video texture is gone";
+}
+
+// Makes sure a frame-locked follower's script VCR shows the movie frame the leader's shows
+// (ScriptPlayer as LockedMovies: the leader's frame sent in the item slot, the follower taking it
+// by number), though the follower's script started the movie a third of a second later on its own
+// timeline (a follower that joined late). Example failure: the follower's VCR plays on its own
+// timestamps, ten movie frames behind the leader's.
+TEST(ShowStreams, AFollowersScriptVcrShowsTheLeadersMovieFrame) {
+  Harness h("script-vcr-locked");
+  OPEN_OR_SKIP(h);
+  auto clip = test::makeNumberedClip(h.dir() / "numbers.mkv", 30, 30, media::VideoCodec::kH264);
+  ASSERT_TRUE(clip) << clip.error().describe();
+  const auto script = h.dir() / "vcr.mdl";
+  std::ofstream(script) << "tv.movie = \"numbers.mkv\"\ntv.repeat = on\ntv.play\ntexture.switch = video\n"
+                        << "loop 1000\n  draw\nend_loop\n";
+  render::Size size{64, 64};
+  auto output = render::createHeadlessOutput(size);
+  ASSERT_TRUE(output);
+  auto renderer = render::Renderer::create();
+  ASSERT_TRUE(renderer);
+  ManualClock clock;
+  auto loop = runtime::EventLoop::create(clock);
+  ASSERT_TRUE(loop);
+  const auto makePlayer = [&](runtime::Show& show) {
+    auto interpreter = script::Interpreter::load(script);
+    EXPECT_TRUE(interpreter) << interpreter.error().describe();
+    ScriptPlayerOptions options;
+    options.manualClock = true;  // exact: the leader waits for each frame due, the follower for the leader's
+    return std::make_unique<ScriptPlayer>(std::move(*interpreter), show, **renderer, options);
+  };
+  const auto drawFrame = [&](runtime::Show& show, ScriptPlayer& player) {
+    FrameLoop frames({60, 1}, clock, &clock, **loop, show, **output, **renderer);
+    frames.addParticipant(player);
+    auto stats = frames.run();
+    ASSERT_TRUE(stats) << stats.error().describe();
+  };
+  runtime::Show leaderShow = script::startupShow();
+  runtime::Show followerShow = script::startupShow();
+  auto leader = makePlayer(leaderShow);
+  std::unique_ptr<ScriptPlayer> follower;
+  std::vector<std::string> differ;
+  int compared = 0;
+  for (int f = 0; f < 120; ++f) {
+    drawFrame(leaderShow, *leader);
+    LockedMovieFrames sent;
+    leader->lockedMovieFrames(sent);
+    if (f == 20) {
+      follower = makePlayer(followerShow);
+      follower->followLeader(std::chrono::milliseconds(500));
+    }
+    if (follower) {
+      follower->followMovieFrames(sent);
+      drawFrame(followerShow, *follower);
+      LockedMovieFrames shown;
+      follower->lockedMovieFrames(shown);
+      // Its first frame shows nothing yet (its script loads the movie in it, as the leader's did in
+      // frame 0); every later one the leader's frame.
+      if (f > 20 && sent.item >= 0) {
+        ++compared;
+        if (shown.item != sent.item) differ.push_back(fmt::format("{}: {} vs {}", f, sent.item, shown.item));
+      }
+    }
+    clock.advance(fromSeconds(1.0 / 60));
+  }
+  EXPECT_GE(compared, 90) << "the leader's VCR showed too few frames";
+  EXPECT_TRUE(differ.empty()) << differ.size() << " of " << compared
+                              << " frames showed another movie frame (frame: leader vs follower), first: "
+                              << differ.front();
+  EXPECT_GT(follower->movieFrameCounts().corrected, 0) << "its own timeline started later: the number corrects it";
+  EXPECT_EQ(follower->movieFrameCounts().late, 0);
 }
 
 /// Pixels of `image` that are orange (#ff8000 as lit on the sculpture): red well above green,

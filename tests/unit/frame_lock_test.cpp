@@ -434,6 +434,11 @@ struct FakeDirector final : public LockedDirector {
     programme.mode = 2;
     programme.setItemName("a");
   }
+  LockedMovieFrames movies;                    // a leader's: the frames its movies show
+  std::vector<LockedMovieFrames> moviesGiven;  // a follower's: the leader's, before each frame
+  [[nodiscard]] LockedMovieFrames lockedMovieFrames() const override { return movies; }
+  void followMovieFrames(const LockedMovieFrames& frames) override { moviesGiven.push_back(frames); }
+  [[nodiscard]] LockedMovieCounts movieFrameCounts() const override { return {2, 0}; }
   [[nodiscard]] LockedProgramme lockedProgramme() const override { return programme; }
   bool followProgramme(const LockedProgramme& p, Nanos showTime) override {
     if (p == programme && !followed.empty()) return false;
@@ -443,8 +448,24 @@ struct FakeDirector final : public LockedDirector {
   }
 };
 
+/// Movies no director plays (a script's VCR, --movie streams) as the lock sees them: they use
+/// the item slot and the last texture slot; a leader's show frame f's number there, a follower's
+/// record the leader's before each frame.
+struct FakeMovies final : public LockedMovies {
+  std::int64_t frame = -1;               // a leader's: the frame drawn
+  std::vector<LockedMovieFrames> given;  // a follower's: the leader's, before each frame
+  void lockedMovieFrames(LockedMovieFrames& frames) const override {
+    frames.item = frame < 0 ? -1 : static_cast<std::int32_t>(frame % 30);
+    frames.textures[3] = frame < 0 ? -1 : static_cast<std::int32_t>((frame + 7) % 30);
+  }
+  void followMovieFrames(const LockedMovieFrames& frames) override { given.push_back(frames); }
+  [[nodiscard]] LockedMovieCounts movieFrameCounts() const override { return {3, 1}; }
+};
+
 struct FollowerNode {
   FakeDirector director;
+  FakeMovies movies;
+  bool withMovies = false;               // the run has movies besides the director's (addMovies)
   std::int64_t reloadAfter = -1;         // the frame after which this node's show is reloaded
   std::vector<std::size_t> commandsRun;  // how many of the leader's commands ran before each frame
   std::vector<std::int64_t> frames;
@@ -462,6 +483,7 @@ struct FollowerNode {
       return;
     }
     (*lock)->setDirector(&director);
+    if (withMovies) (*lock)->addMovies(movies);
     NullOutput output;
     const auto giveUp = std::chrono::steady_clock::now() + std::chrono::seconds(60);
     while (std::chrono::steady_clock::now() < giveUp) {
@@ -487,6 +509,8 @@ struct FollowerNode {
 
 struct LeaderNode {
   FakeDirector director;
+  FakeMovies movies;
+  bool withMovies = false;                       // the run has movies besides the director's (addMovies)
   std::int64_t switchAt = -1;                    // the frame in which the leader's item becomes "b"
   std::map<std::int64_t, std::string> commands;  // script commands its director runs, by frame
   std::int64_t resetAt = -1;                     // the frame in which an item starts a new Show
@@ -506,9 +530,11 @@ struct LeaderNode {
       return;
     }
     (*lock)->setDirector(&director);
+    if (withMovies) (*lock)->addMovies(movies);
     NullOutput output;
     joined = (*lock)->awaitFollowers(**loop);
     for (std::int64_t f = 0; f < frames; ++f) {
+      movies.frame = f;
       show.rotateGlobal({1.0f, 0.5f, 0.25f});  // the show moves every frame
       FrameContext context{f, std::chrono::milliseconds(16) * f, f + 1 == frames};
       if (f == switchAt) {  // a control request's `next`, handled by the leader's director
@@ -739,6 +765,41 @@ TEST(FrameLock, FollowersSwitchItemsInTheLeadersFrame) {
     EXPECT_EQ(f->figures.programmeChanges, 1);
   }
   EXPECT_EQ(leader.figures.programmeChanges, 1);
+}
+
+// Makes sure movies no director plays (a script's VCR, --movie streams: LockedMovies) are sent
+// with every frame in their own slots and handed to a follower's before it draws that frame,
+// while the follower's director gets the leader's other slots and -1 in theirs; their corrected
+// and late frames add to the director's. Example failure: the follower's movies given the frame
+// before (shown one frame late), or its director told to show the script's movie frame as its
+// movie item's.
+TEST(FrameLock, MoviesBesidesTheDirectorsAreSentInTheirSlots) {
+  const int port = freePortPair() + 8;
+  constexpr std::int64_t kFrames = 90;
+  LeaderNode leader;
+  leader.withMovies = true;
+  leader.director.movies = {5, {10, 11, -1, 13}};
+  FollowerNode a;
+  a.withMovies = true;
+  std::thread ta([&] { a.run(followerSpec(port, "a")); });
+  std::thread tl([&] { leader.run(leaderSpec(port, 1, 2000), kFrames, std::chrono::microseconds(200)); });
+  tl.join();
+  ta.join();
+  ASSERT_TRUE(leader.failure.empty()) << leader.failure;
+  ASSERT_TRUE(a.failure.empty()) << a.failure;
+  ASSERT_EQ(a.frames.size(), static_cast<std::size_t>(kFrames));
+  ASSERT_EQ(a.movies.given.size(), a.frames.size());
+  ASSERT_EQ(a.director.moviesGiven.size(), a.frames.size());
+  for (std::size_t i = 0; i < a.frames.size(); ++i) {
+    const std::int64_t f = a.frames[i];
+    // The movies' slots carry what they showed in frame f on the leader, the rest the director's.
+    const LockedMovieFrames sent{static_cast<std::int32_t>(f % 30),
+                                 {10, 11, -1, static_cast<std::int32_t>((f + 7) % 30)}};
+    EXPECT_EQ(a.movies.given[i], sent) << "frame " << f;
+    EXPECT_EQ(a.director.moviesGiven[i], (LockedMovieFrames{-1, {10, 11, -1, -1}})) << "frame " << f;
+  }
+  EXPECT_EQ(a.figures.movieFramesCorrected, 2 + 3);
+  EXPECT_EQ(a.figures.movieFramesLate, 1);
 }
 
 }  // namespace
