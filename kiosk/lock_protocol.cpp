@@ -49,7 +49,7 @@ class Writer {
   /// `text` (at most `field` bytes), NUL-padded to `field`.
   void padded(std::string_view text, std::size_t field) {
     const std::size_t n = std::min(text.size(), field);
-    std::memcpy(out_.data() + at_, text.data(), n);
+    if (n > 0) std::memcpy(out_.data() + at_, text.data(), n);  // an empty view's data may be null
     std::memset(out_.data() + at_ + n, 0, field - n);
     at_ += field;
   }
