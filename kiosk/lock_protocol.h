@@ -61,6 +61,10 @@ LockedShowState captureLockedState(const runtime::Show& show);
 /// \brief Puts the leader's state into a follower's Show.
 void applyLockedState(const LockedShowState& state, runtime::Show& show);
 
+/// How many of a show's movie streams the frame lock carries (their pass and shown frame), in
+/// the manifest's texture order; later ones keep their own timeline.
+inline constexpr std::size_t kLockedMovieStreams = 16;
+
 /// \brief The leader's programme (thesis §4.5: one director for the group): what its kiosk
 /// policy plays, since when, and when its show's media streams started, so that followers play
 /// the same item from the same point and their movies show the same video frame.
@@ -77,7 +81,7 @@ struct LockedProgramme {
   /// One pass of each of the show's first looping movie streams on the leader's timeline (0:
   /// not looped yet), in the manifest's texture order: where a follower joining late places
   /// the current loop.
-  std::array<std::int64_t, 4> moviePassNs{};
+  std::array<std::int64_t, kLockedMovieStreams> moviePassNs{};
   friend bool operator==(const LockedProgramme&, const LockedProgramme&) = default;
   [[nodiscard]] std::string itemName() const;
   void setItemName(std::string_view name);
@@ -106,10 +110,17 @@ struct LockedCommand {
 /// shows the same video frame): its number in its clip, -1 for none (no such movie, nothing on
 /// screen yet). A follower shows exactly these frames, whatever its own decoder's timestamps add
 /// up to (MoviePlayer::frameNumbered).
+/// \brief -1 (no frame) in every stream's place.
+constexpr std::array<std::int32_t, kLockedMovieStreams> noMovieFrames() {
+  std::array<std::int32_t, kLockedMovieStreams> none{};
+  none.fill(-1);
+  return none;
+}
+
 struct LockedMovieFrames {
   std::int32_t item = -1;  ///< the movie item of the playlist
   /// The show's first movie streams, in the manifest's texture order (as LockedProgramme::moviePassNs).
-  std::array<std::int32_t, 4> textures{-1, -1, -1, -1};
+  std::array<std::int32_t, kLockedMovieStreams> textures = noMovieFrames();
   friend bool operator==(const LockedMovieFrames&, const LockedMovieFrames&) = default;
 };
 
@@ -180,13 +191,13 @@ constexpr std::size_t kLockHeaderBytes = 8;
 /// centre and three numbers, the viewer's position and rotation, the eye spacing.
 constexpr std::size_t kLockedStateBytes = 284;
 /// Flags, mode, display, a reserved byte, the index, two times, the reload count, four reserved
-/// bytes, the item's name and four movie passes.
-constexpr std::size_t kLockedProgrammeBytes = 96;
+/// bytes, the item's name and the movie streams' passes.
+constexpr std::size_t kLockedProgrammeBytes = 64 + 8 * kLockedMovieStreams;
 /// The epoch, the newest and base numbers, the text's length, flags, a reserved byte and the
 /// text, NUL-padded.
 constexpr std::size_t kLockedCommandBytes = 16 + kFrameCommandBytes;
-/// The item's and four textures' movie frames, four reserved bytes.
-constexpr std::size_t kLockedMovieFramesBytes = 24;
+/// The item's and the movie streams' frames, four reserved bytes.
+constexpr std::size_t kLockedMovieFramesBytes = 8 + 4 * kLockedMovieStreams;
 constexpr std::size_t kFrameMessageBytes =
     kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes + kLockedCommandBytes + kLockedMovieFramesBytes;
 constexpr std::size_t kPresentMessageBytes = kLockHeaderBytes + 8;

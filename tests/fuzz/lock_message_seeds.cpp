@@ -54,7 +54,8 @@ basalt::kiosk::FrameMessage frame() {
   m.command.newest = 3;
   m.command.base = 1;
   m.movies.item = 17;
-  m.movies.textures = {29, -1, -1, -1};
+  m.movies.textures = basalt::kiosk::noMovieFrames();
+  m.movies.textures[0] = 29;
   return m;
 }
 

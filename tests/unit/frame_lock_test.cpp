@@ -263,7 +263,7 @@ TEST(LockProtocol, MovieFramesRoundTripAndBadOnesAreRejected) {
   auto back = decodeFrame(bytesOf(b, encode(none, b)));
   ASSERT_TRUE(back) << back.error().message();
   EXPECT_EQ(back->movies.item, -1);
-  EXPECT_EQ(back->movies.textures, (std::array<std::int32_t, 4>{-1, -1, -1, -1}));
+  EXPECT_EQ(back->movies.textures, noMovieFrames());
   const std::size_t n = encode(sampleFrame(), b);
   back = decodeFrame(bytesOf(b, n));
   ASSERT_TRUE(back) << back.error().message();
@@ -273,23 +273,24 @@ TEST(LockProtocol, MovieFramesRoundTripAndBadOnesAreRejected) {
   const auto rejects = [&](FrameMessage m, std::string_view why) {
     LockBuffer bad{};
     auto d = decodeFrame(bytesOf(bad, encode(m, bad)));
-    ASSERT_FALSE(d) << "accepted item " << m.movies.item << ", textures " << m.movies.textures[0] << " "
-                    << m.movies.textures[3];
+    ASSERT_FALSE(d) << "accepted item " << m.movies.item << ", textures " << m.movies.textures.front() << " "
+                    << m.movies.textures.back();
     EXPECT_NE(d.error().message().find(why), std::string::npos) << d.error().message();
   };
   FrameMessage m = sampleFrame();
   m.movies.item = -2;
   rejects(m, "movie frame below -1");
-  for (std::size_t i = 0; i < 4; ++i) {
+  for (std::size_t i = 0; i < kLockedMovieStreams; ++i) {
     m = sampleFrame();
     m.movies.textures[i] = std::numeric_limits<std::int32_t>::min();
     rejects(m, "movie frame below -1");
   }
-  for (std::size_t at = kMoviesAt + 20; at < kFrameMessageBytes; ++at) {
+  constexpr std::size_t kReservedAt = kMoviesAt + 4 + 4 * kLockedMovieStreams;
+  for (std::size_t at = kReservedAt; at < kFrameMessageBytes; ++at) {
     LockBuffer bad = b;
     bad[at] = std::byte{1};
     auto d = decodeFrame(bytesOf(bad, n));
-    ASSERT_FALSE(d) << "accepted reserved byte " << at - kMoviesAt - 20 << " = 1";
+    ASSERT_FALSE(d) << "accepted reserved byte " << at - kReservedAt << " = 1";
     EXPECT_NE(d.error().message().find("reserved bytes after the movie frames"), std::string::npos)
         << d.error().message();
   }
@@ -456,7 +457,7 @@ struct FakeMovies final : public LockedMovies {
   std::vector<LockedMovieFrames> given;  // a follower's: the leader's, before each frame
   void lockedMovieFrames(LockedMovieFrames& frames) const override {
     frames.item = frame < 0 ? -1 : static_cast<std::int32_t>(frame % 30);
-    frames.textures[3] = frame < 0 ? -1 : static_cast<std::int32_t>((frame + 7) % 30);
+    frames.textures.back() = frame < 0 ? -1 : static_cast<std::int32_t>((frame + 7) % 30);
   }
   void followMovieFrames(const LockedMovieFrames& frames) override { given.push_back(frames); }
   [[nodiscard]] LockedMovieCounts movieFrameCounts() const override { return {3, 1}; }
@@ -778,7 +779,14 @@ TEST(FrameLock, MoviesBesidesTheDirectorsAreSentInTheirSlots) {
   constexpr std::int64_t kFrames = 90;
   LeaderNode leader;
   leader.withMovies = true;
-  leader.director.movies = {5, {10, 11, -1, 13}};
+  // The director's movie item and its first four streams (the last slot is the movies').
+  const auto directors = [](std::int32_t lastSlot) {
+    std::array<std::int32_t, kLockedMovieStreams> t = noMovieFrames();
+    t[0] = 10, t[1] = 11, t[3] = 13;
+    t.back() = lastSlot;
+    return t;
+  };
+  leader.director.movies = {5, directors(-1)};
   FollowerNode a;
   a.withMovies = true;
   std::thread ta([&] { a.run(followerSpec(port, "a")); });
@@ -793,10 +801,9 @@ TEST(FrameLock, MoviesBesidesTheDirectorsAreSentInTheirSlots) {
   for (std::size_t i = 0; i < a.frames.size(); ++i) {
     const std::int64_t f = a.frames[i];
     // The movies' slots carry what they showed in frame f on the leader, the rest the director's.
-    const LockedMovieFrames sent{static_cast<std::int32_t>(f % 30),
-                                 {10, 11, -1, static_cast<std::int32_t>((f + 7) % 30)}};
+    const LockedMovieFrames sent{static_cast<std::int32_t>(f % 30), directors(static_cast<std::int32_t>((f + 7) % 30))};
     EXPECT_EQ(a.movies.given[i], sent) << "frame " << f;
-    EXPECT_EQ(a.director.moviesGiven[i], (LockedMovieFrames{-1, {10, 11, -1, -1}})) << "frame " << f;
+    EXPECT_EQ(a.director.moviesGiven[i], (LockedMovieFrames{-1, directors(-1)})) << "frame " << f;
   }
   EXPECT_EQ(a.figures.movieFramesCorrected, 2 + 3);
   EXPECT_EQ(a.figures.movieFramesLate, 1);
