@@ -239,8 +239,16 @@ class LibcameraCamera final : public VideoSource {
 
   // libcamera's thread.
   void completed(lc::Request* request) {
-    if (request->status() == lc::Request::RequestCancelled || !session_) return;
+    if (!session_) return;
     Session* s = session_;
+    if (request->status() == lc::Request::RequestCancelled) {
+      // Cancelled: the camera is stopping or cannot take buffers any more (unplugged). Nothing is
+      // queued again from here on: a request queued now could come back after stop(), which
+      // libcamera treats as fatal.
+      std::lock_guard lock(s->mutex_);
+      s->running_ = false;
+      return;
+    }
     auto it = request->buffers().find(s->stream_);
     if (it == request->buffers().end()) return;
     const lc::FrameBuffer* buffer = it->second;
@@ -287,7 +295,14 @@ class LibcameraCamera final : public VideoSource {
     deliver(std::move(frame));
   }
 
-  void disconnected() { reportLost(Error(Errc::kDeviceLost, "the camera was disconnected", info().path)); }
+  void disconnected() {
+    if (session_) {
+      // As for a cancelled request: no request is queued again once the camera is gone.
+      std::lock_guard lock(session_->mutex_);
+      session_->running_ = false;
+    }
+    reportLost(Error(Errc::kDeviceLost, "the camera was disconnected", info().path));
+  }
 
   std::shared_ptr<LibcameraProvider::State> state_;
   V4l2Options options_;
