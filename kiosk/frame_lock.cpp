@@ -15,6 +15,7 @@
 #include <cerrno>
 #include <cstring>
 #include <map>
+#include <random>
 
 #include <fmt/format.h>
 
@@ -114,6 +115,7 @@ struct FrameLock::Impl {
   // Leader.
   std::map<std::string, Follower, std::less<>> followers;
   std::optional<std::pair<std::uint32_t, std::uint32_t>> announced;  // (epoch, newest) of the last frame
+  std::uint32_t session = drawSession();  // this run, in every frame (a follower sees a restart by it)
   // Follower.
   std::optional<FrameMessage> pending;  // the newest frame received and not drawn yet
   std::int64_t current = -1;            // the frame being drawn
@@ -123,6 +125,7 @@ struct FrameLock::Impl {
   bool joined = false;
   bool waitingReported = false;
   Nanos lastHello{-1};
+  std::optional<std::uint32_t> leaderSession;  // the leader's run whose frames this node draws
   // Follower: the leader's script commands.
   std::optional<std::uint32_t> commandEpoch;          // the leader's log being followed
   std::uint32_t lastCommandRun = 0;                   // the last of its commands run on this show
@@ -136,6 +139,14 @@ struct FrameLock::Impl {
   Impl(const LockSpec& s, const Clock& c, runtime::Show& sh) : spec(s), clock(c), show(sh) {}
 
   [[nodiscard]] bool isLeader() const { return spec.role == LockRole::kLeader; }
+
+  /// A number for this run, never 0 (a frame's session 0 is one from before sessions).
+  static std::uint32_t drawSession() {
+    std::random_device entropy;
+    std::uint32_t n = 0;
+    while (n == 0) n = entropy();
+    return n;
+  }
 
   void send(void* socket, std::size_t n) {
     // Never blocks: a peer whose queue is full loses the message (PUB drops; DEALER with no
@@ -225,6 +236,7 @@ struct FrameLock::Impl {
     }
     // The run's other movies write their own slots (after the director's: theirs win).
     for (const LockedMovies* other : movies) other->lockedMovieFrames(m.movies);
+    m.session = session;
     send(pub.get(), encode(m, buffer));
   }
 
@@ -446,6 +458,7 @@ struct FrameLock::Impl {
         if (current >= 0 && f.frame > current + 1) figures.skipped += f.frame - current - 1;
         current = f.frame;
         joined = true;
+        noteSession(f);
         // The leader's programme before any participant runs: the director plays the item the
         // leader plays in this very frame.
         if (director && f.programme.present) {
@@ -473,6 +486,23 @@ struct FrameLock::Impl {
       (void)zmq_poll(&item, 1, std::min<long>(5, std::max<long>(1, static_cast<long>(left.count() / 1'000'000))));
       if (auto r = loop.dispatch(Nanos{0}); !r) return std::unexpected(r.error());
     }
+  }
+
+  /// A frame from another run of the leader than the last: the leader restarted. Its show is
+  /// new, and the commands run on the old one are gone with it: the director loads this node's
+  /// show again (it then takes the new leader's commands from the first).
+  void noteSession(const FrameMessage& f) {
+    if (leaderSession && *leaderSession != f.session) {
+      log::warn(kLogLock, "frame {}: the leader restarted; this node loads its show again to start where it starts",
+                f.frame);
+      ++figures.leaderRestarts;
+      commandEpoch.reset();
+      lastCommandRun = 0;
+      commandsHeld.clear();
+      resendFrom = 0;
+      if (director) director->leaderRestarted();
+    }
+    leaderSession = f.session;
   }
 
   /// What a frame says of the leader's commands: a new log (the leader reloaded), the newest
@@ -810,11 +840,12 @@ std::string FrameLock::describe() const {
   return fmt::format(
       "frame lock: follower '{}': drew {} frames, {}..{}, checksum {:016x}, {} skipped, {} presented without the "
       "leader's word, skew at most {} frames, leader lost {} times, clock offset {} us (largest {} us), delay median "
-      "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times, {} programme changes followed, {} of "
+      "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times (restarted {}), {} programme changes "
+      "followed, {} of "
       "the leader's commands run ({} re-sent, {} lost), {} movie frames corrected to the leader's, {} late",
       f.node, f.framesDrawn, f.firstFrame, f.lastFrame, f.frameChecksum, f.skipped, f.presentsMissed, f.maxSkewFrames,
       f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs, f.malformed, f.leaderReturned,
-      f.programmeChanges, f.commandsApplied, f.commandsResent, f.commandsLost, f.movieFramesCorrected,
+      f.leaderRestarts, f.programmeChanges, f.commandsApplied, f.commandsResent, f.commandsLost, f.movieFramesCorrected,
       f.movieFramesLate);
 }
 

@@ -56,6 +56,10 @@ class LockedDirector {
   /// \brief Follower: plays the leader's programme from the frame at `showTime` on (called
   /// before any participant's beforeDraw). True when what plays changed.
   virtual bool followProgramme(const LockedProgramme& programme, Nanos showTime) = 0;
+  /// \brief Follower: the leader restarted (its frames come from a new run): the show it
+  /// plays, and the commands run on it, start anew; this node's should too (called before the
+  /// new run's programme is followed).
+  virtual void leaderRestarted() {}
   /// \brief Leader: the movie frame each of its movies shows in this frame (called in the lock's
   /// beforeDraw, after the director's).
   [[nodiscard]] virtual LockedMovieFrames lockedMovieFrames() const { return {}; }

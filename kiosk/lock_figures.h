@@ -35,6 +35,7 @@ struct FrameLockFigures {
   bool holding = false;               ///< the leader is lost and this node holds its last picture
   double holdingSeconds = 0;          ///< how long it has held it (0 when not holding)
   std::int64_t leaderReturned = 0;    ///< times a lost leader came back
+  std::int64_t leaderRestarts = 0;    ///< times the leader's frames came from a new run of it
   std::int64_t heldFrame = -1;        ///< the frame held while holding
   std::int64_t programmeChanges = 0;  ///< times the programme changed (leader: sent; follower: followed)
   std::int64_t commandsApplied = 0;   ///< script commands run (leader: its own, logged; follower: the leader's)

@@ -260,7 +260,7 @@ std::size_t encode(const FrameMessage& m, LockBuffer& out) {
   w.padded(carried ? std::string_view(c.text) : std::string_view(), kFrameCommandBytes);
   w.put(m.movies.item);
   for (const std::int32_t shown : m.movies.textures) w.put(shown);
-  w.put(std::uint32_t{0});
+  w.put(m.session);
   return w.size();
 }
 
@@ -410,11 +410,7 @@ Result<FrameMessage> decodeFrame(std::span<const std::byte> bytes) {
   LockedMovieFrames& movies = m.movies;
   movies.item = r.get<std::int32_t>();
   for (std::int32_t& shown : movies.textures) shown = r.get<std::int32_t>();
-  const auto reserved4 = r.get<std::uint32_t>();
-  if (reserved4 != 0) {
-    return fail(Errc::kParse,
-                "frame-lock message: the 'frame' message's reserved bytes after the movie frames are not zero");
-  }
+  m.session = r.get<std::uint32_t>();
   if (movies.item < -1 ||
       std::any_of(movies.textures.begin(), movies.textures.end(), [](std::int32_t shown) { return shown < -1; })) {
     return fail(Errc::kParse, "frame-lock message: a movie frame below -1 (-1 means none)");

@@ -142,6 +142,9 @@ struct FrameMessage {
   LockedProgramme programme;
   LockedCommand command;     ///< since version 3
   LockedMovieFrames movies;  ///< since version 3
+  /// The leader's run: a number it draws when it starts (since version 3). A follower that sees
+  /// it change knows the leader restarted (its show, and the commands run on it, are new).
+  std::uint32_t session = 0;
   friend bool operator==(const FrameMessage&, const FrameMessage&) = default;
 };
 
@@ -196,7 +199,7 @@ constexpr std::size_t kLockedProgrammeBytes = 64 + 8 * kLockedMovieStreams;
 /// The epoch, the newest and base numbers, the text's length, flags, a reserved byte and the
 /// text, NUL-padded.
 constexpr std::size_t kLockedCommandBytes = 16 + kFrameCommandBytes;
-/// The item's and the movie streams' frames, four reserved bytes.
+/// The item's and the movie streams' frames, the leader's session.
 constexpr std::size_t kLockedMovieFramesBytes = 8 + 4 * kLockedMovieStreams;
 constexpr std::size_t kFrameMessageBytes =
     kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes + kLockedCommandBytes + kLockedMovieFramesBytes;

@@ -802,6 +802,15 @@ LockedProgramme ShowDirector::lockedProgramme() const {
   return l;
 }
 
+void ShowDirector::leaderRestarted() {
+  if (!follower_) return;
+  // The leader's show started anew: so does this node's (the commands run on the old one are
+  // gone on the leader), and the new leader's reload count is taken as it comes.
+  log::info(kLogDirector, "the frame-lock leader restarted; reloading this node's show");
+  leaderReloads_.reset();
+  requestReload();
+}
+
 bool ShowDirector::followProgramme(const LockedProgramme& l, Nanos showTime) {
   if (!follower_ || !policy_) return false;
   // The leader reloaded its manifest: so does this node (its own copy of the show folder).

@@ -84,6 +84,7 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
 
   [[nodiscard]] LockedProgramme lockedProgramme() const override;
   bool followProgramme(const LockedProgramme& programme, Nanos showTime) override;
+  void leaderRestarted() override;
   [[nodiscard]] LockedMovieFrames lockedMovieFrames() const override;
   void followMovieFrames(const LockedMovieFrames& frames) override { leaderMovies_ = frames; }
   [[nodiscard]] LockedMovieCounts movieFrameCounts() const override { return movieCounts_; }

@@ -128,6 +128,7 @@ std::string healthJson(const StatusSnapshot& s) {
         "\"frames_drawn\": {}, \"last_frame\": {}, \"skipped\": {}, \"presents_missed\": {}, \"skew_frames_max\": {}, "
         "\"clock_offset_us\": {}, \"delay_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"malformed\": {}, "
         "\"holding\": {}, \"holding_seconds\": {:.1f}, \"held_frame\": {}, \"leader_returned\": {}, "
+        "\"leader_restarts\": {}, "
         "\"watchdog_pings_holding\": {}, \"programme_changes\": {}, \"commands_applied\": {}, "
         "\"commands_resent\": {}, \"commands_lost\": {}, \"movie_frames_corrected\": {}, "
         "\"movie_frames_late\": {}}},\n",
@@ -136,8 +137,8 @@ std::string healthJson(const StatusSnapshot& s) {
         l->barrierWaitMaxMs, l->leaderPresent ? "true" : "false", l->leaderLost, l->framesDrawn, l->lastFrame,
         l->skipped, l->presentsMissed, l->maxSkewFrames, l->leader ? l->maxClockOffsetUs : l->clockOffsetUs,
         l->delayP50Ms, l->delayMaxMs, l->malformed, l->holding ? "true" : "false", l->holdingSeconds, l->heldFrame,
-        l->leaderReturned, l->watchdogPingsHolding, l->programmeChanges, l->commandsApplied, l->commandsResent,
-        l->commandsLost, l->movieFramesCorrected, l->movieFramesLate);
+        l->leaderReturned, l->leaderRestarts, l->watchdogPingsHolding, l->programmeChanges, l->commandsApplied,
+        l->commandsResent, l->commandsLost, l->movieFramesCorrected, l->movieFramesLate);
   }
   out += "  \"devices\": [";
   for (std::size_t i = 0; i < s.devices.size(); ++i) {
@@ -287,6 +288,8 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
       lockMetric("basalt_lock_holding", "gauge", "1 while this follower holds its picture for a lost leader.",
                  l->holding ? 1 : 0);
       lockMetric("basalt_lock_leader_returned_total", "counter", "Times a lost leader came back.", l->leaderReturned);
+      lockMetric("basalt_lock_leader_restarts_total", "counter", "Times the leader's frames came from a new run of it.",
+                 l->leaderRestarts);
       lockMetric("basalt_lock_frames_skipped_total", "counter", "Leader frames this follower passed over.", l->skipped);
       lockMetric("basalt_lock_presents_missed_total", "counter", "Frames presented without the leader's word.",
                  l->presentsMissed);

@@ -56,6 +56,7 @@ basalt::kiosk::FrameMessage frame() {
   m.movies.item = 17;
   m.movies.textures = basalt::kiosk::noMovieFrames();
   m.movies.textures[0] = 29;
+  m.session = 0x5EED;
   return m;
 }
 
