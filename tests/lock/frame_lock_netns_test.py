@@ -197,6 +197,16 @@ def start(basalt, ns, show, *extra, tag):
     return subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, text=True, env=env), out.name
 
 
+def wait_for_line(log, text, seconds):
+    """Waits until a node's log has a line with `text` (its stderr is not buffered)."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if text in open(log).read():
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"no '{text}' in {log} after {seconds} s:\n{open(log).read()[-3000:]}")
+
+
 def summary(log):
     text = open(log).read()
     lines = re.findall(r"frame lock: (?:leader|follower) '[^']*': .*", text)
@@ -295,6 +305,9 @@ def run_rejoin(basalt, work, clip=None):
     a, alog = start(basalt, NODE_A, ashow, tag="a")
     b, blog = start(basalt, NODE_B, bshow, tag="b-first")
     leader, llog = start(basalt, LEADER, lshow, "--frames", str(frames), "--realtime", tag="leader")
+    # Three seconds into the leader's frames, not its start-up (which a sanitizer build makes
+    # slow): the follower is killed mid-run, so that it comes back at a later frame.
+    wait_for_line(llog, "follower 'b' joined", 120)
     time.sleep(3)
     b.send_signal(signal.SIGKILL)
     b.wait()
