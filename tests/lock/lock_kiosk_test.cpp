@@ -125,18 +125,32 @@ std::optional<long> switchFrame(const std::string& output, const std::string& ve
     if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why; \
   } while (false)
 
+/// A leader and a follower of the two-item show on loopback, in real time, started and waited
+/// for until the follower hears the leader and plays the first item.
+struct LockedPair {
+  std::unique_ptr<test::RunningShow> leader;
+  std::unique_ptr<test::RunningShow> follower;
+
+  void start(const std::string& name, int port) {
+    const auto leaderShow = writeNode(name + "-leader", leaderLock(port));
+    const auto followerShow = writeNode(name + "-follower", followerLock(port, 3000));
+    std::string why;
+    leader = test::RunningShow::start({leaderShow.string(), "--realtime", "--no-resume"}, {}, why);
+    ASSERT_TRUE(leader) << why;
+    follower = test::RunningShow::start({followerShow.string(), "--realtime", "--no-resume"}, {}, why);
+    ASSERT_TRUE(follower) << why;
+    std::string last;
+    ASSERT_TRUE(healthSays(*follower, {"\"item\": \"first\"", "\"leader_present\": true"}, 20s, &last)) << last;
+  }
+};
+
 TEST(LockedKiosk, NextOnTheLeaderSwitchesTheFollowerInTheSameFrame) {
   REQUIRE_EGL();
-  const int port = lockPort(0);
-  const auto leaderShow = writeNode("lock-kiosk-next-leader", leaderLock(port));
-  const auto followerShow = writeNode("lock-kiosk-next-follower", followerLock(port, 3000));
-  std::string why;
-  auto leader = test::RunningShow::start({leaderShow.string(), "--realtime", "--no-resume"}, {}, why);
-  ASSERT_TRUE(leader) << why;
-  auto follower = test::RunningShow::start({followerShow.string(), "--realtime", "--no-resume"}, {}, why);
-  ASSERT_TRUE(follower) << why;
+  LockedPair pair;
+  ASSERT_NO_FATAL_FAILURE(pair.start("lock-kiosk-next", lockPort(0)));
+  auto& leader = pair.leader;
+  auto& follower = pair.follower;
   std::string last;
-  ASSERT_TRUE(healthSays(*follower, {"\"item\": \"first\"", "\"leader_present\": true"}, 20s, &last)) << last;
 
   // A follower is not moved on its own: the leader decides for the group.
   const std::string bearer = std::string("Bearer ") + kToken;
@@ -206,16 +220,11 @@ bool cornerTurnsRed(const test::RunningShow& show, const std::string& name, std:
 // follower's facets stay black, or the follower runs a command that parts it from the group.
 TEST(LockedKiosk, ACommandOnTheLeaderRunsOnTheFollowerInTheSameFrame) {
   REQUIRE_EGL();
-  const int port = lockPort(2);
-  const auto leaderShow = writeNode("lock-kiosk-command-leader", leaderLock(port));
-  const auto followerShow = writeNode("lock-kiosk-command-follower", followerLock(port, 3000));
-  std::string why;
-  auto leader = test::RunningShow::start({leaderShow.string(), "--realtime", "--no-resume"}, {}, why);
-  ASSERT_TRUE(leader) << why;
-  auto follower = test::RunningShow::start({followerShow.string(), "--realtime", "--no-resume"}, {}, why);
-  ASSERT_TRUE(follower) << why;
+  LockedPair pair;
+  ASSERT_NO_FATAL_FAILURE(pair.start("lock-kiosk-command", lockPort(2)));
+  auto& leader = pair.leader;
+  auto& follower = pair.follower;
   std::string last;
-  ASSERT_TRUE(healthSays(*follower, {"\"item\": \"first\"", "\"leader_present\": true"}, 20s, &last)) << last;
   const auto before = cornerColour(*follower, "lock-kiosk-command-before");
   ASSERT_TRUE(before);
   EXPECT_LT((*before)[0], 200) << "the default background is not red";
