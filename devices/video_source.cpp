@@ -166,15 +166,22 @@ bool VideoSource::deliver(FrameRef frame) {
   }
   lastDelivery_.store(clock_.now().count(), std::memory_order_relaxed);
   const std::int64_t interval = minInterval_.load(std::memory_order_acquire);
-  const std::int64_t pts = frame->pts.count();
+  std::int64_t pts = frame->pts.count();
+  const std::int64_t last = lastKeptPts_.load(std::memory_order_relaxed);
   if (interval > 0) {
-    const std::int64_t last = lastKeptPts_.load(std::memory_order_relaxed);
     // Keep a frame when a whole interval has passed since the last kept one (with 1% slack so
     // that 30 fps from a 60 fps camera keeps every other frame despite timestamp jitter).
     if (last != INT64_MIN && pts - last < interval - interval / 100) {
       rateDrops_.fetch_add(1, std::memory_order_relaxed);
       return false;
     }
+  }
+  // Two frames captured within one tick of the clock (a manual clock that the producer reads
+  // between the show's steps, a driver with coarse timestamps) would carry the same time; the
+  // later one is put a nanosecond after the earlier, so presentation order is capture order.
+  if (last != INT64_MIN && pts <= last) {
+    pts = last + 1;
+    frame->pts = Nanos{pts};
   }
   lastKeptPts_.store(pts, std::memory_order_relaxed);
   delivered_.fetch_add(1, std::memory_order_relaxed);

@@ -157,7 +157,11 @@ TEST_P(VideoSourceContract, FramesAreWellFormedInOrderAndNeverEarly) {
     EXPECT_LE(f->pts, clock_.now()) << "a frame from the future";
     EXPECT_GT(f->pts, lastPts) << "frames out of order";
     if (frames > 1) {
-      EXPECT_GT(f->sequence, lastSequence);
+      // The sequence is the driver's count, passed on as it is: it never goes back, but a driver
+      // may repeat one (vivid's HDMI input under emulation numbered two buffers 0, 9 ms apart,
+      // when its thread caught up; interlaced fields share theirs). The presentation time is
+      // Basalt's and strictly rises (above).
+      EXPECT_GE(f->sequence, lastSequence) << "the sequence went back";
     }
     lastPts = f->pts;
     lastSequence = f->sequence;
