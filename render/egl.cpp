@@ -6,6 +6,8 @@
 #include <cstring>
 #include <mutex>
 
+#include "render/gl.h"
+
 namespace basalt::render {
 
 std::string_view eglErrorName(EGLint error) {
@@ -114,14 +116,39 @@ Result<std::shared_ptr<EglDisplay>> EglDisplay::openSurfaceless() {
   return openPlatform(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, "the surfaceless platform");
 }
 
+namespace {
+thread_local EglContext* tCurrent = nullptr;  // what makeCurrent() last made current here
+}  // namespace
+
 EglContext::EglContext(std::shared_ptr<EglDisplay> display, EGLContext context)
     : display_(std::move(display)), context_(context) {}
 
 EglContext::~EglContext() {
+  if (tCurrent == this) tCurrent = nullptr;
   if (eglGetCurrentContext() == context_) {
+    // The kept programs go with the context; deleting them first keeps leak checkers quiet.
+    for (const auto& [key, id] : programs_) glDeleteProgram(id);
     eglMakeCurrent(display_->handle(), EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   }
   eglDestroyContext(display_->handle(), context_);
+}
+
+EglContext* EglContext::current() {
+  return tCurrent && eglGetCurrentContext() == tCurrent->context_ ? tCurrent : nullptr;
+}
+
+std::uint32_t EglContext::keptProgram(std::string_view key) const {
+  const auto it = programs_.find(key);
+  return it == programs_.end() ? 0 : it->second;
+}
+
+void EglContext::keepProgram(std::string key, std::uint32_t id) {
+  if (const auto it = programs_.find(key); it != programs_.end()) {
+    glDeleteProgram(it->second);
+    it->second = id;
+    return;
+  }
+  programs_.emplace(std::move(key), id);
 }
 
 Result<std::unique_ptr<EglContext>> EglContext::create(std::shared_ptr<EglDisplay> display, EGLConfig config) {
@@ -141,10 +168,11 @@ Result<std::unique_ptr<EglContext>> EglContext::create(std::shared_ptr<EglDispla
   return std::unique_ptr<EglContext>(new EglContext(std::move(display), context));
 }
 
-Result<void> EglContext::makeCurrent(EGLSurface surface) const {
+Result<void> EglContext::makeCurrent(EGLSurface surface) {
   if (!eglMakeCurrent(display_->handle(), surface, surface, context_)) {
     return fail(Errc::kUnavailable, fmt::format("eglMakeCurrent failed ({})", eglErrorName(eglGetError())));
   }
+  tCurrent = this;
   return {};
 }
 

@@ -7,6 +7,8 @@
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 
+#include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -57,14 +59,25 @@ class EglContext {
   EglContext& operator=(const EglContext&) = delete;
 
   /// \brief Makes the context current on this thread with `surface` (or none).
-  [[nodiscard]] Result<void> makeCurrent(EGLSurface surface = EGL_NO_SURFACE) const;
+  [[nodiscard]] Result<void> makeCurrent(EGLSurface surface = EGL_NO_SURFACE);
   [[nodiscard]] EGLContext handle() const { return context_; }
   [[nodiscard]] const std::shared_ptr<EglDisplay>& display() const { return display_; }
+
+  /// \brief The context this thread last made current through makeCurrent() (null when none,
+  /// or when it has been destroyed).
+  [[nodiscard]] static EglContext* current();
+  /// \brief A GL program kept under `key` for the context's life (0 when none): what many
+  /// objects compile alike (a stream texture's conversion programs, made again each time a movie
+  /// item starts) is compiled once. The context frees them with itself.
+  [[nodiscard]] std::uint32_t keptProgram(std::string_view key) const;
+  /// \brief Hands program `id` to the context under `key` (the context must be current).
+  void keepProgram(std::string key, std::uint32_t id);
 
  private:
   EglContext(std::shared_ptr<EglDisplay> display, EGLContext context);
   std::shared_ptr<EglDisplay> display_;
   EGLContext context_;
+  std::map<std::string, std::uint32_t, std::less<>> programs_;
 };
 
 /// \brief True when the space-separated extension list `all` names `name` exactly (EGL and GL).

@@ -2,9 +2,11 @@
 //
 // Serves: every FrameSource (movies, cameras, capture cards). CPU frames are uploaded plane by
 // plane in the layout they come in (I420, YV12, NV12, NV21, YUYV, UYVY, RGBA, BGRA, GRAY8) and
-// converted by one full-target draw with the stream's colorimetry. Frames backed by dmabufs are
-// imported as EGL images where the display offers EGL_EXT_image_dma_buf_import (Mesa's
-// surfaceless llvmpipe does not; then the frame must also be mapped, and is uploaded).
+// converted by one full-target draw with the stream's colorimetry; on a software renderer 4:2:0
+// frames take the packed pass (eight pixels a fragment, copied into the texture through a pixel
+// buffer, bottom row first). Opaque pictures at the texture's size are blitted. Frames backed
+// by dmabufs are imported as EGL images where the display offers EGL_EXT_image_dma_buf_import
+// (Mesa's surfaceless llvmpipe does not; then the frame must also be mapped, and is uploaded).
 // Limits: no mipmaps (a video texture is sampled linearly); MJPEG must be decoded first
 // (media::MjpegDecoder). Configuration: none; the path taken is logged once per stream.
 
@@ -14,8 +16,10 @@
 #include <EGL/eglext.h>
 #include <GLES2/gl2ext.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 #include <fmt/format.h>
 
@@ -62,6 +66,7 @@ struct PlaneFormat {
   std::uint32_t bytesPerTexel;
   std::uint32_t width;
   std::uint32_t height;
+  GLenum type = GL_UNSIGNED_BYTE;
 };
 
 /// The texture each plane of `frame` goes into.
@@ -86,6 +91,34 @@ int planeFormats(const Frame& frame, std::array<PlaneFormat, 3>& out) {
     case PixelFormat::kUyvy: out[0] = {GL_RGBA8, GL_RGBA, 4, cw, h}; return 1;
     default: return 0;
   }
+}
+
+/// The textures of a 4:2:0 frame for the packed pass (yuv_packed.frag): every plane as R32UI,
+/// four 8-bit samples a texel, rows read a whole texel further than the picture where its width
+/// is not a multiple of four. 0 when the frame cannot take it: another layout, an odd height (the
+/// pass pairs rows that share chroma), or rows too short, unaligned or a stride that is not a
+/// whole number of texels.
+int packedPlaneFormats(const Frame& frame, std::array<PlaneFormat, 3>& out) {
+  const bool threePlanes = frame.format == PixelFormat::kI420 || frame.format == PixelFormat::kYv12;
+  const bool twoPlanes = frame.format == PixelFormat::kNv12 || frame.format == PixelFormat::kNv21;
+  if ((!threePlanes && !twoPlanes) || frame.height % 2 != 0 || frame.width == 0) return 0;
+  const std::uint32_t quads = (frame.width + 3) / 4;  // fragments across: four pixels each
+  const std::uint32_t chromaRows = frame.height / 2;
+  out[0] = {GL_R32UI, GL_RED_INTEGER, 4, quads, frame.height, GL_UNSIGNED_INT};
+  // Three planes: a chroma texel holds four samples, eight pixels; two: two UV pairs, four pixels.
+  const std::uint32_t chromaTexels = threePlanes ? (quads + 1) / 2 : quads;
+  out[1] = {GL_R32UI, GL_RED_INTEGER, 4, chromaTexels, chromaRows, GL_UNSIGNED_INT};
+  out[2] = out[1];
+  const int count = threePlanes ? 3 : 2;
+  if (frame.planeCount < count) return 0;
+  for (int i = 0; i < count; ++i) {
+    const Plane& p = frame.planes[static_cast<std::size_t>(i)];
+    const PlaneFormat& pf = out[static_cast<std::size_t>(i)];
+    if (!p.data || reinterpret_cast<std::uintptr_t>(p.data) % 4 != 0 || p.stride % 4 != 0 || p.stride < pf.width * 4) {
+      return 0;
+    }
+  }
+  return count;
 }
 
 /// Column-major YUV->RGB matrix and offsets for the shader, range folded in.
@@ -126,24 +159,44 @@ void setSampling(GLenum filter) {
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 }
 
-/// The conversion program for one layout.
+/// The conversion program for one layout: the current EGL context's copy (compiled once for all
+/// the stream textures drawing in it), or one of its own where none is known.
 struct ConversionProgram {
-  gl::Program program;
+  GLuint program = 0;
+  gl::Program owned;
   GLint yCoef = -1, uCoef = -1, vCoef = -1, bias = -1, rect = -1, flip = -1, flipX = -1, chromaScale = -1,
-        mirrorWidth = -1;
+        mirrorWidth = -1, height = -1;
 };
 
-/// yuv.frag with LAYOUT defined: one program per layout, so no pixel runs a branch.
-Result<ConversionProgram> buildConversion(int layout) {
-  std::string_view text = shaders::kYuvFrag;
-  const auto firstLine = text.find('\n');
-  const std::string source =
-      fmt::format("{}\n#define LAYOUT {}\n{}", text.substr(0, firstLine), layout, text.substr(firstLine + 1));
-  auto program = gl::buildProgram(shaders::kQuadVert, source, fmt::format("yuv layout {}", layout));
-  if (!program) return std::unexpected(program.error());
+/// yuv.frag (or yuv_packed.frag) with LAYOUT defined: one program per layout, so no pixel runs
+/// a branch.
+Result<ConversionProgram> buildConversion(int layout, bool packed = false) {
   ConversionProgram c;
-  c.program = std::move(*program);
-  const GLuint p = c.program.id();
+  EglContext* context = EglContext::current();
+  const std::string key = fmt::format("stream_texture.yuv.{}{}", layout, packed ? ".packed" : "");
+  c.program = context ? context->keptProgram(key) : 0;
+  if (c.program == 0) {
+    std::string_view text = packed ? shaders::kYuvPackedFrag : shaders::kYuvFrag;
+    const auto firstLine = text.find('\n');
+    const std::string source =
+        fmt::format("{}\n#define LAYOUT {}\n{}", text.substr(0, firstLine), layout, text.substr(firstLine + 1));
+    auto program =
+        gl::buildProgram(shaders::kQuadVert, source, fmt::format("yuv layout {}{}", layout, packed ? " (packed)" : ""));
+    if (!program) return std::unexpected(program.error());
+    const GLuint id = program->id();
+    glUseProgram(id);
+    glUniform1i(glGetUniformLocation(id, "uPlane0"), 0);
+    glUniform1i(glGetUniformLocation(id, "uPlane1"), 1);
+    glUniform1i(glGetUniformLocation(id, "uPlane2"), 2);
+    glUseProgram(0);
+    if (context) {
+      context->keepProgram(key, program->release());
+    } else {
+      c.owned = std::move(*program);
+    }
+    c.program = id;
+  }
+  const GLuint p = c.program;
   c.yCoef = glGetUniformLocation(p, "uYCoef");
   c.uCoef = glGetUniformLocation(p, "uUCoef");
   c.vCoef = glGetUniformLocation(p, "uVCoef");
@@ -153,25 +206,51 @@ Result<ConversionProgram> buildConversion(int layout) {
   c.flipX = glGetUniformLocation(p, "uFlipX");
   c.chromaScale = glGetUniformLocation(p, "uChromaScale");
   c.mirrorWidth = glGetUniformLocation(p, "uMirrorWidth");
-  glUseProgram(p);
-  glUniform1i(glGetUniformLocation(p, "uPlane0"), 0);
-  glUniform1i(glGetUniformLocation(p, "uPlane1"), 1);
-  glUniform1i(glGetUniformLocation(p, "uPlane2"), 2);
-  glUseProgram(0);
+  c.height = glGetUniformLocation(p, "uHeight");
   return c;
+}
+
+/// The stream's colorimetry into a conversion program's uniforms (the program in use).
+void setColourUniforms(const ConversionProgram& c, const Colorimetry& colorimetry) {
+  std::array<float, 9> m{};
+  std::array<float, 3> offset{};
+  colorMatrix(colorimetry, m, offset);
+  // Columns of m are the Y, U and V contributions; the bias is -m * offset.
+  glUniform3f(c.yCoef, m[0], m[1], m[2]);
+  glUniform3f(c.uCoef, m[3], m[4], m[5]);
+  glUniform3f(c.vCoef, m[6], m[7], m[8]);
+  glUniform3f(c.bias, -(m[0] * offset[0] + m[3] * offset[1] + m[6] * offset[2]),
+              -(m[1] * offset[0] + m[4] * offset[1] + m[7] * offset[2]),
+              -(m[2] * offset[0] + m[5] * offset[1] + m[8] * offset[2]));
+}
+
+/// Whether the current context renders in software (Mesa's llvmpipe or softpipe, SwiftShader).
+bool softwareRenderer() {
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  if (!renderer) return false;
+  const std::string_view r(renderer);
+  return r.find("llvmpipe") != std::string_view::npos || r.find("softpipe") != std::string_view::npos ||
+         r.find("SwiftShader") != std::string_view::npos;
 }
 
 }  // namespace
 
 struct StreamTexture::Gpu {
-  std::array<ConversionProgram, 8> programs;  // by layout, built on first use
-  gl::VertexArray vao;                        // attributeless draws still need a bound VAO in ES 3
+  std::array<ConversionProgram, 8> programs;        // by layout, built on first use
+  std::array<ConversionProgram, 8> packedPrograms;  // yuv_packed.frag, by layout (4:2:0 ones)
+  gl::VertexArray vao;                              // attributeless draws still need a bound VAO in ES 3
   std::array<gl::Texture, 3> planes;
   std::array<PlaneFormat, 3> planeFormat{};
   int planeCount = 0;
   gl::Texture target;
   gl::Framebuffer fbo;
   std::uint32_t width = 0, height = 0;
+  // The packed pass: even and odd target rows as RGBA32UI (a texel: four packed RGBA8 pixels),
+  // and the pixel buffer they are copied through into `target`.
+  std::array<gl::Texture, 2> packedRows;
+  gl::Framebuffer packedFbo;
+  gl::Buffer packedPixels;
+  std::uint32_t packedWidth = 0, packedHeight = 0;
   PFNGLEGLIMAGETARGETTEXTURE2DOESPROC imageTargetTexture = nullptr;
   PFNEGLCREATEIMAGEKHRPROC createImage = nullptr;
   PFNEGLDESTROYIMAGEKHRPROC destroyImage = nullptr;
@@ -184,10 +263,13 @@ StreamTexture::~StreamTexture() = default;
 Result<std::unique_ptr<StreamTexture>> StreamTexture::create(std::string name) {
   std::unique_ptr<StreamTexture> s(new StreamTexture(std::move(name)));
   Gpu& g = *s->gpu_;
-  // The common decoder layout is built now, so that a broken shader fails at start-up.
-  auto i420 = buildConversion(kThreePlanes);
+  // The common decoder layout is built now, for the pass this renderer takes, so that a broken
+  // shader fails at start-up.
+  const bool packed = softwareRenderer();
+  s->conversionPass_ = packed ? ConversionPass::kPacked : ConversionPass::kPerPixel;
+  auto i420 = buildConversion(kThreePlanes, packed);
   if (!i420) return std::unexpected(i420.error());
-  g.programs[kThreePlanes] = std::move(*i420);
+  (packed ? g.packedPrograms : g.programs)[kThreePlanes] = std::move(*i420);
   g.vao = gl::VertexArray::create();
   const EGLDisplay display = eglGetCurrentDisplay();
   const char* extensions = display != EGL_NO_DISPLAY ? eglQueryString(display, EGL_EXTENSIONS) : nullptr;
@@ -260,10 +342,10 @@ void StreamTexture::showFallback() {
   shownPts_ = -1;
 }
 
-Result<void> StreamTexture::uploadPlanes(const Frame& frame) {
+Result<void> StreamTexture::uploadPlanes(const Frame& frame, bool packed) {
   Gpu& g = *gpu_;
   std::array<PlaneFormat, 3> formats{};
-  const int count = planeFormats(frame, formats);
+  const int count = packed ? packedPlaneFormats(frame, formats) : planeFormats(frame, formats);
   if (count == 0 || frame.planeCount < count) {
     return fail(Errc::kUnsupported, fmt::format("stream '{}': {} frames cannot be shown (decode MJPEG first)", name_,
                                                 pixelFormatName(frame.format)));
@@ -289,7 +371,7 @@ Result<void> StreamTexture::uploadPlanes(const Frame& frame) {
     if (plane.stride % pf.bytesPerTexel == 0) {
       glPixelStorei(GL_UNPACK_ROW_LENGTH, static_cast<GLint>(plane.stride / pf.bytesPerTexel));
       glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, static_cast<GLsizei>(pf.width), static_cast<GLsizei>(pf.height),
-                      pf.format, GL_UNSIGNED_BYTE, plane.data);
+                      pf.format, pf.type, plane.data);
     } else {
       // A stride that is not a whole number of texels: row by row.
       glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
@@ -368,13 +450,124 @@ Result<void> StreamTexture::importDmabuf(const Frame& frame) {
 }
 
 Result<void> StreamTexture::convert(const Uploaded& planes) {
+  if (planes.packed) return convertPacked(planes);
   Gpu& g = *gpu_;
   glBindFramebuffer(GL_FRAMEBUFFER, g.fbo.id());
   glViewport(0, 0, static_cast<GLsizei>(g.width), static_cast<GLsizei>(g.height));
   auto drawn = drawPlanes(planes, {-1.0f, -1.0f, 1.0f, 1.0f}, false);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  if (drawn) converted_ = true;
+  if (drawn) {
+    converted_ = true;
+    view_.bottomUp = false;
+  }
   return drawn;
+}
+
+Result<void> StreamTexture::ensurePackedTarget(std::uint32_t quads, std::uint32_t rowPairs) {
+  Gpu& g = *gpu_;
+  if (g.packedFbo && g.packedWidth == quads && g.packedHeight == rowPairs) return {};
+  g.packedFbo = gl::Framebuffer::create();
+  glBindFramebuffer(GL_FRAMEBUFFER, g.packedFbo.id());
+  for (std::size_t i = 0; i < g.packedRows.size(); ++i) {
+    g.packedRows[i] = gl::Texture::create();
+    glBindTexture(GL_TEXTURE_2D, g.packedRows[i].id());
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32UI, static_cast<GLsizei>(quads), static_cast<GLsizei>(rowPairs));
+    setSampling(GL_NEAREST);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i), GL_TEXTURE_2D,
+                           g.packedRows[i].id(), 0);
+  }
+  glBindTexture(GL_TEXTURE_2D, 0);
+  const std::array<GLenum, 2> buffers = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glDrawBuffers(2, buffers.data());
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    g.packedFbo.reset();
+    return fail(Errc::kUnavailable, fmt::format("stream '{}': cannot render into RGBA32UI textures (0x{:x})", name_,
+                                                static_cast<unsigned>(status)));
+  }
+  g.packedPixels = gl::Buffer::create();
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, g.packedPixels.id());
+  glBufferData(GL_PIXEL_PACK_BUFFER, static_cast<GLsizeiptr>(std::size_t{quads} * 16 * rowPairs * 2), nullptr,
+               GL_STREAM_COPY);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  g.packedWidth = quads;
+  g.packedHeight = rowPairs;
+  return {};
+}
+
+Result<void> StreamTexture::convertPacked(const Uploaded& planes) {
+  Gpu& g = *gpu_;
+  const int layout = layoutOf(planes.format);
+  ConversionProgram& c = g.packedPrograms[static_cast<std::size_t>(layout)];
+  if (!c.program) {
+    auto built = buildConversion(layout, true);
+    if (!built) return std::unexpected(built.error());
+    c = std::move(*built);
+  }
+  const std::uint32_t quads = (planes.width + 3) / 4, rowPairs = planes.height / 2;
+  if (auto r = ensurePackedTarget(quads, rowPairs); !r) return r;
+  glBindFramebuffer(GL_FRAMEBUFFER, g.packedFbo.id());
+  glViewport(0, 0, static_cast<GLsizei>(quads), static_cast<GLsizei>(rowPairs));
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glUseProgram(c.program);
+  setColourUniforms(c, planes.colorimetry);
+  glUniform4f(c.rect, -1.0f, -1.0f, 1.0f, 1.0f);
+  glUniform1i(c.flip, 0);
+  glUniform1i(c.flipX, 0);
+  glUniform1i(c.height, static_cast<GLint>(planes.height));
+  bindPlanes(planes.format);
+  glBindVertexArray(g.vao.id());
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  glBindVertexArray(0);
+  unbindPlanes();
+  glUseProgram(0);
+  // Even and odd rows into one pixel buffer, interleaved (each read skips the other's rows);
+  // then into the RGBA texture as the bytes they are. Both copies stay on the GPU's side.
+  const std::size_t rowBytes = std::size_t{quads} * 16;
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, g.packedPixels.id());
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glPixelStorei(GL_PACK_ROW_LENGTH, static_cast<GLint>(quads * 2));
+  for (std::size_t i = 0; i < g.packedRows.size(); ++i) {
+    glReadBuffer(static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i));
+    glReadPixels(0, 0, static_cast<GLsizei>(quads), static_cast<GLsizei>(rowPairs), GL_RGBA_INTEGER, GL_UNSIGNED_INT,
+                 reinterpret_cast<void*>(i * rowBytes));  // NOLINT(performance-no-int-to-ptr): a buffer offset
+  }
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, g.packedPixels.id());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, static_cast<GLint>(quads * 4));
+  glBindTexture(GL_TEXTURE_2D, g.target.id());
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, static_cast<GLsizei>(planes.width), static_cast<GLsizei>(planes.height),
+                  GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+  converted_ = true;
+  view_.bottomUp = true;
+  return {};
+}
+
+void StreamTexture::bindPlanes(PixelFormat format) {
+  // YV12 stores V before U: bind the planes so that unit 1 is always U.
+  const bool swapUv = format == PixelFormat::kYv12;
+  for (int i = 0; i < 3; ++i) {
+    int source = i;
+    if (swapUv && i > 0) source = 3 - i;
+    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
+    glBindTexture(GL_TEXTURE_2D, source < gpu_->planeCount ? gpu_->planes[static_cast<std::size_t>(source)].id() : 0);
+  }
+}
+
+void StreamTexture::unbindPlanes() {
+  for (int i = 2; i >= 0; --i) {
+    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
+    glBindTexture(GL_TEXTURE_2D, 0);
+  }
 }
 
 Result<void> StreamTexture::drawPlanes(const Uploaded& planes, const std::array<float, 4>& ndc, bool flip) {
@@ -389,17 +582,8 @@ Result<void> StreamTexture::drawPlanes(const Uploaded& planes, const std::array<
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
-  glUseProgram(c.program.id());
-  std::array<float, 9> m{};
-  std::array<float, 3> offset{};
-  colorMatrix(planes.colorimetry, m, offset);
-  // Columns of m are the Y, U and V contributions; the bias is -m * offset.
-  glUniform3f(c.yCoef, m[0], m[1], m[2]);
-  glUniform3f(c.uCoef, m[3], m[4], m[5]);
-  glUniform3f(c.vCoef, m[6], m[7], m[8]);
-  glUniform3f(c.bias, -(m[0] * offset[0] + m[3] * offset[1] + m[6] * offset[2]),
-              -(m[1] * offset[0] + m[4] * offset[1] + m[7] * offset[2]),
-              -(m[2] * offset[0] + m[5] * offset[1] + m[8] * offset[2]));
+  glUseProgram(c.program);
+  setColourUniforms(c, planes.colorimetry);
   glUniform4f(c.rect, ndc[0], ndc[1], ndc[2], ndc[3]);
   glUniform1i(c.flip, flip ? 1 : 0);
   if (c.chromaScale >= 0) {
@@ -411,21 +595,11 @@ Result<void> StreamTexture::drawPlanes(const Uploaded& planes, const std::array<
   // sampled through coordinates, the shader what is fetched by position).
   glUniform1i(c.flipX, mirror_ ? 1 : 0);
   glUniform1i(c.mirrorWidth, mirror_ ? static_cast<GLint>(planes.width) : 0);
-  // YV12 stores V before U: bind the planes so that unit 1 is always U.
-  const bool swapUv = planes.format == PixelFormat::kYv12;
-  for (int i = 0; i < 3; ++i) {
-    int source = i;
-    if (swapUv && i > 0) source = 3 - i;
-    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
-    glBindTexture(GL_TEXTURE_2D, source < g.planeCount ? g.planes[static_cast<std::size_t>(source)].id() : 0);
-  }
+  bindPlanes(planes.format);
   glBindVertexArray(g.vao.id());
   glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
   glBindVertexArray(0);
-  for (int i = 2; i >= 0; --i) {
-    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
-    glBindTexture(GL_TEXTURE_2D, 0);
-  }
+  unbindPlanes();
   glUseProgram(0);
   return {};
 }
@@ -465,7 +639,7 @@ void StreamTexture::drawPicture(PictureOverlay& overlay, const PictureRect& rect
     if (fallback_) overlay.draw(view_, rect, viewport, opacity);
     return;
   }
-  if (pictureOnly_ && opacity >= 1.0f && drawableFromPlanes(uploaded_.format)) {
+  if (pictureOnly_ && opacity >= 1.0f && !uploaded_.packed && drawableFromPlanes(uploaded_.format)) {
     const std::array<float, 4> ndc = pictureNdc(rect, viewport);
     // At the frame's own size the planes are read texel by texel (nearest: a plain load in a
     // software renderer); scaled, they are filtered as the texture path filters its texture.
@@ -494,7 +668,41 @@ void StreamTexture::drawPicture(PictureOverlay& overlay, const PictureRect& rect
     if (auto r = ensureConverted(); !r) log::warn(kLogRender, "stream '{}': {}", name_, r.error().describe());
     glBindFramebuffer(GL_FRAMEBUFFER, static_cast<GLuint>(bound));
   }
+  if (opacity >= 1.0f && blitPicture(rect, viewport)) {
+    ++blitPictures_;
+    return;
+  }
   overlay.draw(view_, rect, viewport, opacity);
+}
+
+bool StreamTexture::blitPicture(const PictureRect& rect, Size viewport) {
+  // At the texture's own size, on whole pixels, inside the output: a copy, no draw. A texture
+  // stored bottom row first (the packed pass's) copies straight; one stored top row first is
+  // copied upside down, which costs a software renderer a draw's worth.
+  const Gpu& g = *gpu_;
+  if (rect.x != std::floor(rect.x) || rect.y != std::floor(rect.y) || rect.x < 0 || rect.y < 0 ||
+      std::lround(rect.width) != g.width || std::lround(rect.height) != g.height ||
+      rect.x + rect.width > static_cast<float>(viewport.width) ||
+      rect.y + rect.height > static_cast<float>(viewport.height)) {
+    return false;
+  }
+  GLint samples = 0;
+  glGetIntegerv(GL_SAMPLE_BUFFERS, &samples);
+  if (samples != 0) return false;  // a multisampled output takes no blit from a texture
+  GLint read = 0;
+  glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read);
+  const auto x0 = static_cast<GLint>(rect.x), x1 = x0 + static_cast<GLint>(g.width);
+  const auto top = static_cast<GLint>(viewport.height) - static_cast<GLint>(rect.y);
+  const GLint bottom = top - static_cast<GLint>(g.height);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, g.fbo.id());
+  const auto w = static_cast<GLint>(g.width), h = static_cast<GLint>(g.height);
+  if (view_.bottomUp) {
+    glBlitFramebuffer(0, 0, w, h, x0, bottom, x1, top, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  } else {
+    glBlitFramebuffer(0, 0, w, h, x0, top, x1, bottom, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(read));
+  return true;
 }
 
 void StreamTexture::setMirror(bool mirror) {
@@ -528,21 +736,38 @@ Result<bool> StreamTexture::update(const FrameRef& ref) {
   if (path == UploadPath::kPlanes && frame.format == PixelFormat::kRgba8 && !mirror_) {
     // Already what the renderer samples: straight into the target, no pass.
     if (auto r = uploadRgba(frame); !r) return std::unexpected(r.error());
-    uploaded_ = {frame.format, frame.width, frame.height, frame.colorimetry};
+    uploaded_ = {frame.format, frame.width, frame.height, frame.colorimetry, false};
     converted_ = true;
+    view_.bottomUp = false;
   } else {
+    std::array<PlaneFormat, 3> packedFormats{};
+    const bool packed = path == UploadPath::kPlanes && conversionPass_ == ConversionPass::kPacked && !mirror_ &&
+                        packedPlaneFormats(frame, packedFormats) > 0;
     if (path == UploadPath::kPlanes) {
-      if (auto r = uploadPlanes(frame); !r) return std::unexpected(r.error());
+      if (auto r = uploadPlanes(frame, packed); !r) return std::unexpected(r.error());
     }
-    uploaded_ = {frame.format, frame.width, frame.height, frame.colorimetry};
+    uploaded_ = {frame.format, frame.width, frame.height, frame.colorimetry, packed};
     converted_ = false;
-    // A picture-only stream draws planar frames from their planes: no conversion pass now.
-    if (!(pictureOnly_ && drawableFromPlanes(frame.format))) {
-      if (auto r = convert(uploaded_); !r) return std::unexpected(r.error());
+    // A picture-only stream draws planar frames from their planes: no conversion pass now
+    // (unless the packed pass converts them, which costs less than drawing from the planes).
+    if (!(pictureOnly_ && !packed && drawableFromPlanes(frame.format))) {
+      auto r = convert(uploaded_);
+      if (!r && packed) {
+        // A renderer that cannot take the packed pass (no RGBA32UI targets): the per-pixel pass
+        // from now on, this frame too.
+        log::warn(kLogRender, "{}; converting one pixel a fragment instead", r.error().describe());
+        conversionPass_ = ConversionPass::kPerPixel;
+        if (auto again = uploadPlanes(frame, false); !again) return std::unexpected(again.error());
+        uploaded_.packed = false;
+        r = convert(uploaded_);
+      }
+      if (!r) return std::unexpected(r.error());
     }
   }
-  if (path != path_ || frame.format != format_ || !(frame.colorimetry == colorimetry_)) {
+  if (path != path_ || frame.format != format_ || !(frame.colorimetry == colorimetry_) ||
+      uploaded_.packed != packedShown_) {
     path_ = path;
+    packedShown_ = uploaded_.packed;
     format_ = frame.format;
     colorimetry_ = frame.colorimetry;
     log::info(kLogRender, "{}{}", describe(),
@@ -570,7 +795,8 @@ std::string StreamTexture::describe() const {
   const std::string_view how = path_ == UploadPath::kPlanes && format_ == PixelFormat::kRgba8 && !mirror_
                                    ? std::string_view("uploaded as is (already RGBA)")
                                    : uploadPathName(path_);
-  return fmt::format("stream '{}': {} {}x{}, {}{}{}", name_, pixelFormatName(format_), gpu_->width, gpu_->height, how,
+  return fmt::format("stream '{}': {} {}x{}, {}{}{}{}", name_, pixelFormatName(format_), gpu_->width, gpu_->height, how,
+                     packedShown_ ? " eight pixels a fragment" : "",
                      yuv ? fmt::format(" ({} {} range)", matrixName(colorimetry_),
                                        colorimetry_.range == Colorimetry::Range::kFull ? "full" : "limited")
                          : std::string{},
@@ -583,12 +809,22 @@ Result<void> StreamTexture::readPixels(Image& out) {
   if (out.width != g.width || out.height != g.height || out.channels != 4) out = Image::make(g.width, g.height, 4);
   glBindFramebuffer(GL_FRAMEBUFFER, g.fbo.id());
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  // Texture row 0 is the picture's top row (frames are uploaded top row first).
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
   glReadPixels(0, 0, static_cast<GLsizei>(g.width), static_cast<GLsizei>(g.height), GL_RGBA, GL_UNSIGNED_BYTE,
                out.pixels.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (const GLenum e = gl::drainErrors(); e != GL_NO_ERROR) {
     return fail(Errc::kIo, fmt::format("reading stream '{}' back: {}", name_, gl::errorName(e)));
+  }
+  // Texture row 0 is the picture's top row (frames are uploaded top row first), or its bottom
+  // row after the packed pass.
+  if (view_.bottomUp) {
+    const std::size_t rowBytes = std::size_t{g.width} * 4;
+    for (std::uint32_t y = 0; y < g.height / 2; ++y) {
+      std::swap_ranges(out.pixels.begin() + static_cast<std::ptrdiff_t>(rowBytes * y),
+                       out.pixels.begin() + static_cast<std::ptrdiff_t>(rowBytes * (y + 1)),
+                       out.pixels.begin() + static_cast<std::ptrdiff_t>(rowBytes * (g.height - 1 - y)));
+    }
   }
   return {};
 }
@@ -631,7 +867,7 @@ void PictureOverlay::draw(const TextureView& texture, const PictureRect& rect, S
   }
   glUseProgram(gpu_->program.id());
   glUniform4f(gpu_->rect, ndc[0], ndc[1], ndc[2], ndc[3]);
-  glUniform1i(gpu_->flip, 1);
+  glUniform1i(gpu_->flip, texture.bottomUp ? 0 : 1);
   glUniform1f(gpu_->opacity, opacity);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, texture.id);

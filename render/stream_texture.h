@@ -29,6 +29,13 @@ enum class UploadPath : std::uint8_t {
 
 std::string_view uploadPathName(UploadPath path);
 
+/// \brief How uploaded 4:2:0 planes (I420, YV12, NV12, NV21) become the RGBA texture.
+enum class ConversionPass : std::uint8_t {
+  kPerPixel,  ///< one fragment a pixel into the texture (yuv.frag): what a GPU does best
+  kPacked,    ///< eight pixels a fragment into integer targets, copied into the texture through a
+              ///< pixel buffer (yuv_packed.frag): a third of the CPU time on a software renderer
+};
+
 class PictureOverlay;
 struct PictureRect;
 
@@ -69,6 +76,14 @@ class StreamTexture {
   [[nodiscard]] std::string describe() const;
   /// \brief YUV-to-RGB conversions run (one per new frame).
   [[nodiscard]] std::uint64_t conversions() const { return conversions_; }
+  /// \brief The pass 4:2:0 frames take from the next update() on. The default is kPacked on a
+  /// software renderer (llvmpipe, softpipe, SwiftShader) and kPerPixel on a GPU. Frames the
+  /// packed pass cannot take (odd heights, rows that are not whole 32-bit words, imported
+  /// dmabufs, a mirrored stream) take the per-pixel pass.
+  void setConversionPass(ConversionPass pass) { conversionPass_ = pass; }
+  [[nodiscard]] ConversionPass conversionPass() const { return conversionPass_; }
+  /// \brief Whether the frame shown went through the packed pass.
+  [[nodiscard]] bool packedConversion() const { return uploaded_.packed; }
   /// \brief Whether this EGL display can import dmabufs (EGL_EXT_image_dma_buf_import).
   [[nodiscard]] bool dmabufImportOffered() const { return dmabufOffered_; }
 
@@ -88,12 +103,15 @@ class StreamTexture {
   void drawPicture(PictureOverlay& overlay, const PictureRect& rect, Size viewport, float opacity = 1.0f);
   /// \brief Pictures drawn straight from the planes (the one-pass path), for tests and figures.
   [[nodiscard]] std::uint64_t directPictures() const { return directPictures_; }
+  /// \brief Opaque pictures at the texture's own size, copied into the output by a framebuffer
+  /// blit instead of drawn (straight for a bottom-up texture, flipped for a top-down one).
+  [[nodiscard]] std::uint64_t blitPictures() const { return blitPictures_; }
 
  private:
   struct Gpu;
   explicit StreamTexture(std::string name);
   Result<void> ensureTarget(std::uint32_t width, std::uint32_t height);
-  Result<void> uploadPlanes(const Frame& frame);
+  Result<void> uploadPlanes(const Frame& frame, bool packed);
   Result<void> importDmabuf(const Frame& frame);
   Result<void> uploadRgba(const Frame& frame);
   /// What the planes on the GPU hold: enough to convert or draw them after the frame is gone.
@@ -101,8 +119,14 @@ class StreamTexture {
     PixelFormat format = PixelFormat::kUnknown;
     std::uint32_t width = 0, height = 0;
     Colorimetry colorimetry{};
+    bool packed = false;  // as the packed pass takes them (R32UI planes)
   };
   Result<void> convert(const Uploaded& planes);
+  Result<void> convertPacked(const Uploaded& planes);
+  Result<void> ensurePackedTarget(std::uint32_t quads, std::uint32_t rowPairs);
+  void bindPlanes(PixelFormat format);
+  static void unbindPlanes();
+  bool blitPicture(const PictureRect& rect, Size viewport);
   /// Runs the conversion program over the planes into the bound framebuffer: the whole of it
   /// (`ndc` -1..1, into the target) or a picture rectangle (flipped: frames are top row first).
   Result<void> drawPlanes(const Uploaded& planes, const std::array<float, 4>& ndc, bool flip);
@@ -126,6 +150,9 @@ class StreamTexture {
   bool converted_ = true;  // the target holds the current frame (false: only its planes do)
   Uploaded uploaded_;
   std::uint64_t directPictures_ = 0;
+  std::uint64_t blitPictures_ = 0;
+  ConversionPass conversionPass_ = ConversionPass::kPerPixel;
+  bool packedShown_ = false;  // what the last log line said
   float fallbackColor_[3] = {0.12f, 0.12f, 0.12f};
 };
 
