@@ -18,10 +18,13 @@
 #include <malloc.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cstdint>
 #include <fstream>
 #include <set>
 #include <thread>
+#include <utility>
 
 #include "kiosk/frame_loop.h"
 #include "kiosk/frame_metrics.h"
@@ -105,6 +108,24 @@ class ModeWatcher final : public FrameParticipant {
   const ShowDirector& director_;
   std::array<bool, 3> seen_{};
   bool playedClip_ = false;
+};
+
+/// The lowest small-block heap in use (malloc's, without its large mmapped blocks) seen in an
+/// hour, sampled every simulated minute. Within an hour the heap swings by a few hundred KiB as
+/// items start and end (pipelines, textures, the renderer's caches); one sample an hour lands on
+/// a high or a low at random, while the low of an hour only moves when something stays.
+class HeapLow final : public FrameParticipant {
+ public:
+  void afterPresent(const FrameContext& /*frame*/) override {
+    if (frames_++ % 15 != 0) return;
+    low_ = std::min(low_, ::mallinfo2().uordblks);
+  }
+  /// The hour's low; starts the next hour.
+  std::size_t take() { return std::exchange(low_, SIZE_MAX); }
+
+ private:
+  std::uint64_t frames_ = 0;
+  std::size_t low_ = SIZE_MAX;
 };
 
 /// A trace folder replaying the Huion Keydial mini recording's second device (D:1, the one that
@@ -262,6 +283,8 @@ requests_per_second = 1000
   std::vector<std::size_t> fds;
   std::vector<std::size_t> heap;
   std::vector<std::size_t> mmapped;  // the part of heap in large mmapped blocks
+  std::vector<std::size_t> lows;     // each hour's low of the small-block heap
+  HeapLow heapLow;
   std::vector<std::string> fdLists;  // what was open when the count was over the bound
   httplib::Client client("127.0.0.1", (*server)->port());
   for (int hour = 0; hour < kHours; ++hour) {
@@ -269,6 +292,7 @@ requests_per_second = 1000
     frameLoop.addParticipant(metrics);
     frameLoop.addParticipant(director);
     frameLoop.addParticipant(modes);
+    frameLoop.addParticipant(heapLow);
     auto stats = frameLoop.run();
     ASSERT_TRUE(stats) << stats.error().describe();
     // The hour's requests, as a monitoring system and a technician's phone would make them.
@@ -294,6 +318,7 @@ requests_per_second = 1000
     rss.push_back(residentBytes());
     heap.push_back(heapInUse());
     mmapped.push_back(::mallinfo2().hblkhd);
+    lows.push_back(heapLow.take());
     fds.push_back(fds.empty() ? openFds() : settledFds(fds.front()));
     if (fds.back() > fds[std::min<std::size_t>(fds.size() - 1, 2)] + 8)
       fdLists.push_back(fmt::format("hour {}: {}", hour, describeFds()));
@@ -308,24 +333,32 @@ requests_per_second = 1000
   EXPECT_NE(status.streams[0].message.find("loops"), std::string::npos) << status.streams[0].message;
   EXPECT_TRUE(modes.playedClip()) << "the movie item played";
   // Flat after the warm-up: the first opening at 08:00 draws the cube (shaders, meshes, the GL
-  // driver's buffers) and the log's ring of recent records fills; from 09:00 on nothing grows.
+  // driver's buffers) and the log's ring of recent records fills; from then on nothing grows.
   // Mesa's llvmpipe takes a 1 MiB block for its caches once in a while, on its own schedule (a
   // mmap catchpoint in gdb shows it under Renderer::drawSurface, late in the day): large mmapped
   // blocks may grow by at most 1.1 MiB; the rest of the heap in use, where every small object
   // lives, by at most 256 KiB over 14 hours (12 bytes a frame), so that a leak per frame, per movie
-  // loop or per request fails.
-  const auto small = [&](std::size_t h) {
-    return static_cast<std::ptrdiff_t>(heap[h]) - static_cast<std::ptrdiff_t>(mmapped[h]);
+  // loop or per request fails. The small heap is compared by its lows (HeapLow: one sample an
+  // hour would catch the swings within an hour, which are as large), the highest hourly low of
+  // 11:00-14:00 against that of 21:00-midnight: an hour's low itself falls about 250 KiB now and
+  // then (an hour in which the movie item's pipeline and texture were both gone at a sample).
+  // The small heap warms up for longer than the rest: Mesa keeps about 400 KiB more between 10:00
+  // and 12:00 (seen with the packed conversion pass, then flat for the next 36 hours of a 48-hour
+  // run). Ten hours at 256 KiB still fail a leak of 29 bytes a frame or 9 KiB a start of the
+  // movie item.
+  const auto highestLow = [&](std::size_t from, std::size_t to) {
+    return static_cast<std::ptrdiff_t>(*std::max_element(lows.begin() + static_cast<std::ptrdiff_t>(from),
+                                                         lows.begin() + static_cast<std::ptrdiff_t>(to)));
   };
-  EXPECT_LE(small(heap.size() - 1) - small(9), std::ptrdiff_t{256} * 1024)
-      << "the heap in use (without large blocks) grew by " << (small(heap.size() - 1) - small(9)) / 1024
-      << " KiB from 09:00 to midnight";
+  const std::ptrdiff_t grown = highestLow(21, 24) - highestLow(11, 14);
+  EXPECT_LE(grown, std::ptrdiff_t{256} * 1024) << "the heap in use (without large blocks) grew by " << grown / 1024
+                                               << " KiB from the lows of 11:00-14:00 to those of 21:00-midnight";
   EXPECT_LE(mmapped.back(), mmapped[9] + std::size_t{1126} * 1024)
       << "large blocks grew by " << (mmapped.back() - mmapped[9]) / 1024 << " KiB";
   const std::size_t baseline = rss[9];
   const std::size_t highest = *std::max_element(rss.begin() + 9, rss.end());
   EXPECT_LE(rss.back(), baseline + std::size_t{2048} * 1024)
-      << "resident memory grew by " << (rss.back() - baseline) / 1024 << " KiB from 09:00 to midnight";
+      << "resident memory grew by " << (rss.back() - baseline) / 1024 << " KiB from 10:00 to midnight";
   EXPECT_LE(highest, baseline + std::size_t{3072} * 1024) << "a peak of " << (highest - baseline) / 1024 << " KiB";
   // GStreamer's pipelines open and close socket pairs as the clips loop and the item restarts, so
   // the count at a given moment varies by a few; a descriptor leaked per loop (every 6 s) or
@@ -351,10 +384,13 @@ requests_per_second = 1000
   for (const std::size_t h : mmapped) series += std::to_string(h / 1024) + " ";
   std::printf("soak: of which mmapped blocks, KiB: %s\n", series.c_str());
   series.clear();
+  for (const std::size_t h : lows) series += std::to_string(h / 1024) + " ";
+  std::printf("soak: the small-block heap's low in each hour, KiB: %s\n", series.c_str());
+  series.clear();
   for (const std::size_t n : fds) series += std::to_string(n) + " ";
   std::printf("soak: open descriptors by hour: %s\n", series.c_str());
   std::printf(
-      "soak: 24 simulated hours, %lld frames; resident %zu KiB at 09:00, %zu KiB at midnight (highest %zu "
+      "soak: 24 simulated hours, %lld frames; resident %zu KiB at 10:00, %zu KiB at midnight (highest %zu "
       "KiB); %zu open descriptors at midnight\n",
       static_cast<long long>(figures.frames), baseline / 1024, rss.back() / 1024, highest / 1024, fds.back());
 }
