@@ -290,8 +290,8 @@ std::int64_t failed(const std::string& why) {
 }
 
 /// Plays `count` streams of `file` at 30 fps on the system clock for `seconds`, each through a
-/// stream texture drawn as a quad; returns the frames dropped (shown frame numbers that skip or
-/// repeat after the first half second).
+/// stream texture drawn as a quad, each frame showing what is due at the time it starts; returns
+/// the frames dropped (shown frame numbers that skip or repeat after the first half second).
 std::int64_t droppedWithStreams(const std::filesystem::path& file, int count, double seconds) {
   using namespace basalt;
   auto output = render::createHeadlessOutput({1280, 720});
@@ -324,11 +324,14 @@ std::int64_t droppedWithStreams(const std::filesystem::path& file, int count, do
   for (int n = 0; n < frames; ++n) {
     const Nanos due = frameTime(n, 30);
     while (clock.now() - start < due) std::this_thread::sleep_for(std::chrono::microseconds(500));
+    // The frame shows what is due when it starts, as a show's frame loop does: a loop that falls
+    // behind real time gets later movie frames, and skips some.
+    const Nanos showTime = clock.now() - start;
     // Streams convert into their own textures first (update() leaves framebuffer 0 bound, which
     // a surfaceless output does not have); then the output's frame draws them.
     for (int i = 0; i < count; ++i) {
       const auto idx = static_cast<std::size_t>(i);
-      if (auto r = streams[idx]->update(players[idx]->frameAt(due)); !r) return failed(r.error().describe());
+      if (auto r = streams[idx]->update(players[idx]->frameAt(showTime)); !r) return failed(r.error().describe());
     }
     if (auto r = (*output)->beginFrame(); !r) return failed(r.error().describe());
     for (int i = 0; i < count; ++i) {
