@@ -518,12 +518,7 @@ Result<void> StreamTexture::convertPacked(const Uploaded& planes) {
   glUniform1i(c.flip, 0);
   glUniform1i(c.flipX, 0);
   glUniform1i(c.height, static_cast<GLint>(planes.height));
-  bindPlanes(planes.format);
-  glBindVertexArray(g.vao.id());
-  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-  glBindVertexArray(0);
-  unbindPlanes();
-  glUseProgram(0);
+  drawFromPlanes(planes.format);
   // Even and odd rows into one pixel buffer, interleaved (each read skips the other's rows);
   // then into the RGBA texture as the bytes they are. Both copies stay on the GPU's side.
   const std::size_t rowBytes = std::size_t{quads} * 16;
@@ -552,7 +547,7 @@ Result<void> StreamTexture::convertPacked(const Uploaded& planes) {
   return {};
 }
 
-void StreamTexture::bindPlanes(PixelFormat format) {
+void StreamTexture::drawFromPlanes(PixelFormat format) {
   // YV12 stores V before U: bind the planes so that unit 1 is always U.
   const bool swapUv = format == PixelFormat::kYv12;
   for (int i = 0; i < 3; ++i) {
@@ -561,13 +556,14 @@ void StreamTexture::bindPlanes(PixelFormat format) {
     glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
     glBindTexture(GL_TEXTURE_2D, source < gpu_->planeCount ? gpu_->planes[static_cast<std::size_t>(source)].id() : 0);
   }
-}
-
-void StreamTexture::unbindPlanes() {
+  glBindVertexArray(gpu_->vao.id());
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  glBindVertexArray(0);
   for (int i = 2; i >= 0; --i) {
     glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
     glBindTexture(GL_TEXTURE_2D, 0);
   }
+  glUseProgram(0);
 }
 
 Result<void> StreamTexture::drawPlanes(const Uploaded& planes, const std::array<float, 4>& ndc, bool flip) {
@@ -595,12 +591,7 @@ Result<void> StreamTexture::drawPlanes(const Uploaded& planes, const std::array<
   // sampled through coordinates, the shader what is fetched by position).
   glUniform1i(c.flipX, mirror_ ? 1 : 0);
   glUniform1i(c.mirrorWidth, mirror_ ? static_cast<GLint>(planes.width) : 0);
-  bindPlanes(planes.format);
-  glBindVertexArray(g.vao.id());
-  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-  glBindVertexArray(0);
-  unbindPlanes();
-  glUseProgram(0);
+  drawFromPlanes(planes.format);
   return {};
 }
 

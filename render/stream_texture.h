@@ -124,8 +124,9 @@ class StreamTexture {
   Result<void> convert(const Uploaded& planes);
   Result<void> convertPacked(const Uploaded& planes);
   Result<void> ensurePackedTarget(std::uint32_t quads, std::uint32_t rowPairs);
-  void bindPlanes(PixelFormat format);
-  static void unbindPlanes();
+  /// Draws the quad with the planes bound to units 0-2 (U always on 1), the conversion program
+  /// in use with its uniforms set; leaves nothing bound.
+  void drawFromPlanes(PixelFormat format);
   bool blitPicture(const PictureRect& rect, Size viewport);
   /// Runs the conversion program over the planes into the bound framebuffer: the whole of it
   /// (`ndc` -1..1, into the target) or a picture rectangle (flipped: frames are top row first).
