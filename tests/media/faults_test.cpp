@@ -16,8 +16,6 @@
 
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cstdlib>
 #include <fstream>
 #include <memory>
@@ -57,20 +55,6 @@ class LogCapture {
   std::shared_ptr<log::RingSink> sink_;
 };
 
-/// The full path of a program on PATH (the test's process helper does not search PATH), or empty.
-std::string onPath(std::string_view program) {
-  const char* path = std::getenv("PATH");
-  std::string_view dirs = path ? path : "/usr/bin:/bin";
-  while (!dirs.empty()) {
-    const auto colon = dirs.find(':');
-    const std::filesystem::path candidate = std::filesystem::path(dirs.substr(0, colon)) / program;
-    if (access(candidate.c_str(), X_OK) == 0) return candidate.string();
-    if (colon == std::string_view::npos) break;
-    dirs.remove_prefix(colon + 1);
-  }
-  return {};
-}
-
 /// Plays `player` from show time `t` for `frames` show frames; returns the frame numbers shown.
 std::vector<int> playFrames(MoviePlayer& player, Nanos& t, int frames) {
   std::vector<int> shown;
@@ -89,34 +73,8 @@ TEST(MovieFaults, SoundWithoutAnAudioOutputIsSaidOnceAndThePicturePlaysOn) {
   // Numbered video (Motion-JPEG) and a Vorbis tone, made with GStreamer's own tools.
   auto numbered = test::makeNumberedClip(dir / "numbered.avi", 45, kFps, VideoCodec::kMjpeg, 160, 120, 0);
   ASSERT_TRUE(numbered) << numbered.error().describe();
-  const std::string gstLaunch = onPath("gst-launch-1.0");
-  if (gstLaunch.empty()) GTEST_SKIP() << "gst-launch-1.0 is not installed (gstreamer1.0-tools)";
-  const auto made = test::run({gstLaunch,
-                               "-q",
-                               "filesrc",
-                               "location=" + numbered->string(),
-                               "!",
-                               "avidemux",
-                               "!",
-                               "queue",
-                               "!",
-                               "mux.",
-                               "audiotestsrc",
-                               "num-buffers=70",
-                               "!",
-                               "audioconvert",
-                               "!",
-                               "vorbisenc",
-                               "!",
-                               "queue",
-                               "!",
-                               "mux.",
-                               "matroskamux",
-                               "name=mux",
-                               "!",
-                               "filesink",
-                               "location=" + clip.string()});
-  if (made.exitCode != 0) GTEST_SKIP() << "cannot make a clip with sound here: " << made.output;
+  const auto made = test::addTone(*numbered, clip, 70);
+  if (!made) GTEST_SKIP() << "cannot make a clip with sound here: " << made.error().describe();
 
   LogCapture log;
   MoviePlayerOptions options;

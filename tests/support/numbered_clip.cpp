@@ -5,6 +5,8 @@
 #include <string>
 #include <system_error>
 
+#include "support/process.h"
+
 namespace basalt::test {
 
 Image numberedImage(std::uint32_t width, std::uint32_t height, int number) {
@@ -47,6 +49,41 @@ Result<std::filesystem::path> makeNumberedClip(const std::filesystem::path& path
   if (auto r = (*recorder)->finish(); !r) return std::unexpected(r.error());
   std::filesystem::rename(partial, path, ec);
   if (ec) return fail(Errc::kIo, ec.message(), path.string());
+  return path;
+}
+
+Result<std::filesystem::path> addTone(const std::filesystem::path& video, const std::filesystem::path& path,
+                                      int toneBuffers, double frequency, double volume) {
+  const std::string gstLaunch = onPath("gst-launch-1.0");
+  if (gstLaunch.empty()) return fail(Errc::kUnavailable, "gst-launch-1.0 is not installed (gstreamer1.0-tools)");
+  const auto made = run({gstLaunch,
+                         "-q",
+                         "filesrc",
+                         "location=" + video.string(),
+                         "!",
+                         "avidemux",
+                         "!",
+                         "queue",
+                         "!",
+                         "mux.",
+                         "audiotestsrc",
+                         "freq=" + std::to_string(frequency),
+                         "volume=" + std::to_string(volume),
+                         "num-buffers=" + std::to_string(toneBuffers),
+                         "!",
+                         "audioconvert",
+                         "!",
+                         "vorbisenc",
+                         "!",
+                         "queue",
+                         "!",
+                         "mux.",
+                         "matroskamux",
+                         "name=mux",
+                         "!",
+                         "filesink",
+                         "location=" + path.string()});
+  if (made.exitCode != 0) return fail(Errc::kIo, "gst-launch-1.0 could not make a clip with sound: " + made.output);
   return path;
 }
 

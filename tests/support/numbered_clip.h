@@ -26,6 +26,12 @@ Result<std::filesystem::path> makeNumberedClip(const std::filesystem::path& path
                                                media::VideoCodec codec, std::uint32_t width = 160,
                                                std::uint32_t height = 120, int firstNumber = 0);
 
+/// \brief `video` (an AVI, as makeNumberedClip writes it) with a Vorbis sine tone of `frequency`
+/// Hz beside it, `toneBuffers` of audiotestsrc's buffers long, muxed into Matroska at `path`
+/// with GStreamer's own tools. An error of kUnavailable when gst-launch-1.0 is not installed.
+Result<std::filesystem::path> addTone(const std::filesystem::path& video, const std::filesystem::path& path,
+                                      int toneBuffers, double frequency = 440, double volume = 0.8);
+
 /// \brief The number a decoded frame shows (I420, YV12, NV12, NV21, YUYV, UYVY, RGBA, BGRA,
 /// GRAY8), or -1 when the format is not readable here.
 int readFrameNumber(const Frame& frame);

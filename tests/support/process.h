@@ -9,6 +9,7 @@
 #include <chrono>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace basalt::test {
@@ -48,6 +49,9 @@ class Process {
   int fd_ = -1;
   std::string output_;
 };
+
+/// \brief The full path of `program` on $PATH (Process::start does not search it), or empty.
+std::string onPath(std::string_view program);
 
 /// \brief Starts, waits and returns the result.
 ProcessResult run(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env = {},
