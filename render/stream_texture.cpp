@@ -377,7 +377,7 @@ Result<void> StreamTexture::uploadPlanes(const Frame& frame, bool packed) {
       glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
       for (std::uint32_t y = 0; y < pf.height; ++y) {
         glTexSubImage2D(GL_TEXTURE_2D, 0, 0, static_cast<GLint>(y), static_cast<GLsizei>(pf.width), 1, pf.format,
-                        GL_UNSIGNED_BYTE, plane.data + std::size_t{plane.stride} * y);
+                        pf.type, plane.data + std::size_t{plane.stride} * y);
       }
     }
   }
