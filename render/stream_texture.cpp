@@ -20,6 +20,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -159,6 +160,24 @@ void setSampling(GLenum filter) {
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 }
 
+/// The program the current EGL context keeps under `key` (compiled once for every stream texture
+/// and picture drawing in it), made by `build` (which also sets its sampler units) the first
+/// time. Where no context is known, `owned` keeps the one built.
+template <typename Build>
+Result<GLuint> keptProgram(const std::string& key, gl::Program& owned, Build&& build) {
+  EglContext* context = EglContext::current();
+  if (const GLuint kept = context ? context->keptProgram(key) : 0; kept != 0) return kept;
+  Result<gl::Program> program = std::forward<Build>(build)();
+  if (!program) return std::unexpected(program.error());
+  const GLuint id = program->id();
+  if (context) {
+    context->keepProgram(key, program->release());
+  } else {
+    owned = std::move(*program);
+  }
+  return id;
+}
+
 /// The conversion program for one layout: the current EGL context's copy (compiled once for all
 /// the stream textures drawing in it), or one of its own where none is known.
 struct ConversionProgram {
@@ -172,30 +191,24 @@ struct ConversionProgram {
 /// a branch.
 Result<ConversionProgram> buildConversion(int layout, bool packed = false) {
   ConversionProgram c;
-  EglContext* context = EglContext::current();
-  const std::string key = fmt::format("stream_texture.yuv.{}{}", layout, packed ? ".packed" : "");
-  c.program = context ? context->keptProgram(key) : 0;
-  if (c.program == 0) {
-    std::string_view text = packed ? shaders::kYuvPackedFrag : shaders::kYuvFrag;
-    const auto firstLine = text.find('\n');
-    const std::string source =
-        fmt::format("{}\n#define LAYOUT {}\n{}", text.substr(0, firstLine), layout, text.substr(firstLine + 1));
-    auto program =
-        gl::buildProgram(shaders::kQuadVert, source, fmt::format("yuv layout {}{}", layout, packed ? " (packed)" : ""));
-    if (!program) return std::unexpected(program.error());
-    const GLuint id = program->id();
-    glUseProgram(id);
-    glUniform1i(glGetUniformLocation(id, "uPlane0"), 0);
-    glUniform1i(glGetUniformLocation(id, "uPlane1"), 1);
-    glUniform1i(glGetUniformLocation(id, "uPlane2"), 2);
-    glUseProgram(0);
-    if (context) {
-      context->keepProgram(key, program->release());
-    } else {
-      c.owned = std::move(*program);
-    }
-    c.program = id;
-  }
+  auto kept = keptProgram(
+      fmt::format("stream_texture.yuv.{}{}", layout, packed ? ".packed" : ""), c.owned, [&]() -> Result<gl::Program> {
+        std::string_view text = packed ? shaders::kYuvPackedFrag : shaders::kYuvFrag;
+        const auto firstLine = text.find('\n');
+        const std::string source =
+            fmt::format("{}\n#define LAYOUT {}\n{}", text.substr(0, firstLine), layout, text.substr(firstLine + 1));
+        auto program = gl::buildProgram(shaders::kQuadVert, source,
+                                        fmt::format("yuv layout {}{}", layout, packed ? " (packed)" : ""));
+        if (!program) return program;
+        glUseProgram(program->id());
+        for (int unit = 0; unit < 3; ++unit) {
+          glUniform1i(glGetUniformLocation(program->id(), fmt::format("uPlane{}", unit).c_str()), unit);
+        }
+        glUseProgram(0);
+        return program;
+      });
+  if (!kept) return std::unexpected(kept.error());
+  c.program = *kept;
   const GLuint p = c.program;
   c.yCoef = glGetUniformLocation(p, "uYCoef");
   c.uCoef = glGetUniformLocation(p, "uUCoef");
@@ -823,7 +836,8 @@ Result<void> StreamTexture::readPixels(Image& out) {
 // --- The Zoom picture -----------------------------------------------------------------------
 
 struct PictureOverlay::Gpu {
-  gl::Program program;
+  GLuint program = 0;  // the context's (keptProgram)
+  gl::Program owned;
   GLint rect = -1, flip = -1, opacity = -1;
   gl::VertexArray vao;
 };
@@ -833,16 +847,20 @@ PictureOverlay::~PictureOverlay() = default;
 
 Result<std::unique_ptr<PictureOverlay>> PictureOverlay::create() {
   std::unique_ptr<PictureOverlay> o(new PictureOverlay);
-  auto program = gl::buildProgram(shaders::kQuadVert, shaders::kPictureFrag, "picture");
-  if (!program) return std::unexpected(program.error());
-  o->gpu_->program = std::move(*program);
-  const GLuint p = o->gpu_->program.id();
+  // A movie item makes a picture overlay each time it starts: the program is the context's.
+  auto kept = keptProgram("stream_texture.picture", o->gpu_->owned, []() -> Result<gl::Program> {
+    auto program = gl::buildProgram(shaders::kQuadVert, shaders::kPictureFrag, "picture");
+    if (!program) return program;
+    glUseProgram(program->id());
+    glUniform1i(glGetUniformLocation(program->id(), "uPicture"), 0);
+    glUseProgram(0);
+    return program;
+  });
+  if (!kept) return std::unexpected(kept.error());
+  const GLuint p = o->gpu_->program = *kept;
   o->gpu_->rect = glGetUniformLocation(p, "uRect");
   o->gpu_->flip = glGetUniformLocation(p, "uFlipY");
   o->gpu_->opacity = glGetUniformLocation(p, "uOpacity");
-  glUseProgram(p);
-  glUniform1i(glGetUniformLocation(p, "uPicture"), 0);
-  glUseProgram(0);
   o->gpu_->vao = gl::VertexArray::create();
   return o;
 }
@@ -856,7 +874,7 @@ void PictureOverlay::draw(const TextureView& texture, const PictureRect& rect, S
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   }
-  glUseProgram(gpu_->program.id());
+  glUseProgram(gpu_->program);
   glUniform4f(gpu_->rect, ndc[0], ndc[1], ndc[2], ndc[3]);
   glUniform1i(gpu_->flip, texture.bottomUp ? 0 : 1);
   glUniform1f(gpu_->opacity, opacity);

@@ -497,8 +497,9 @@ TEST_F(StreamTextures, PicturesAtTheirOwnSizeAreCopiedAndLookTheSame) {
   }
 }
 
-// Stream textures made in one context share its conversion programs: a movie item that starts
-// again (a new stream texture each time) compiles nothing; a new context compiles its own.
+// Stream textures and picture overlays made in one context share its programs: a movie item that
+// starts again (a new stream texture and overlay each time) compiles nothing; a new context
+// compiles its own.
 // Example failure: every item start compiling the conversion again (tens of milliseconds of a
 // software renderer's JIT, a hitch at every start, and its memory coming and going).
 TEST_F(StreamTextures, StreamsInOneContextCompileTheConversionOnce) {
@@ -520,6 +521,16 @@ TEST_F(StreamTextures, StreamsInOneContextCompileTheConversionOnce) {
     EXPECT_GT(out.at(2, 2, 0), 200) << "red at the left";
     EXPECT_EQ(context->keptProgram(key), program) << "compiled again";
   }
+  // Picture overlays (a movie item makes one each time it starts) share theirs too.
+  auto first = PictureOverlay::create();
+  ASSERT_TRUE(first);
+  const std::uint32_t picture = context->keptProgram("stream_texture.picture");
+  EXPECT_NE(picture, 0u);
+  auto second = PictureOverlay::create();
+  ASSERT_TRUE(second);
+  EXPECT_EQ(context->keptProgram("stream_texture.picture"), picture) << "compiled again";
+  first->reset();
+  second->reset();
   // Another context: its own programs.
   stream_.reset();
   output_.reset();
