@@ -39,6 +39,8 @@ import xml.etree.ElementTree as ET
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.path.dirname(os.path.dirname(HERE))
+# Host folders the guest covers with tmpfs (guest/init), where programs write.
+GUEST_TMPFS = ("/tmp", "/run", "/var/tmp", "/root")
 EXIT_SKIP = 77
 EXIT_LAB_FAILED = 125
 # The kernel package unpacked is about 400 MB, the .deb 70 MB.
@@ -416,6 +418,11 @@ def prepare(results, build_dir):
         shares.append(build_dir)
     if not any(results == s or results.startswith(s + os.sep) for s in shares):
         shares.append(results)
+    # The guest mounts empty tmpfs over some host folders (programs write there): a checkout in
+    # one of them (a clone in /tmp, say) is shared on its own, or the lab would not see its
+    # scripts. First, so that the build folder's share inside it is mounted over it.
+    if any(SOURCE.startswith(d + os.sep) for d in GUEST_TMPFS):
+        shares.insert(0, SOURCE)
     for p in shares + [results, HERE]:
         check_path(p, "the path")
     camera = HostCamera(build_dir)
