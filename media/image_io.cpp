@@ -122,8 +122,9 @@ Result<void> writeAtomically(const std::filesystem::path& path, WriteFn&& write)
   }
   std::filesystem::rename(temporary, path, ec);
   if (ec) {
+    const std::string why = ec.message();  // before remove() reuses ec
     std::filesystem::remove(temporary, ec);
-    return fail(Errc::kIo, fmt::format("cannot move the image into place: {}", ec.message()), path.string());
+    return fail(Errc::kIo, fmt::format("cannot move the image into place: {}", why), path.string());
   }
   return {};
 }

@@ -7,8 +7,11 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <system_error>
 
 #include "support/test_paths.h"
 
@@ -93,8 +96,13 @@ std::string RunningShow::raw(const std::string& bytes) const {
 }
 
 bool headlessEglWorks(std::string& why) {
+  // A folder of this process's own: test processes probe at once, and scratchDir() empties the
+  // folder it is given (a shared one was emptied under another probe's snapshot).
+  const auto folder = scratchDir("kiosk-egl-probe-" + std::to_string(::getpid()));
   const auto r = run({(binaryDir() / "basalt").string(), "run", "--frames", "1", "--headless", "--snapshot",
-                      (scratchDir("kiosk-egl-probe") / "probe.png").string()});
+                      (folder / "probe.png").string()});
+  std::error_code ec;
+  std::filesystem::remove_all(folder, ec);
   if (r.exitCode == 0) return true;
   why = r.output;
   return false;

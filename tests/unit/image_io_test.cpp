@@ -82,6 +82,17 @@ TEST(ImageIo, BadPathsAndFilesAreClearErrors) {
   EXPECT_NE(garbage.error().describe().find("garbage.png"), std::string::npos);
 
   EXPECT_FALSE(writeImage(dir / "empty.png", Image{}));
+
+  // A folder in the way of the image: the rename's own cause is said, and no partial file stays.
+  std::filesystem::create_directories(dir / "taken.png" / "inside");
+  auto taken = writeImage(dir / "taken.png", gradient(4, 4, 3));
+  ASSERT_FALSE(taken);
+  EXPECT_NE(taken.error().describe().find("cannot move the image into place"), std::string::npos)
+      << taken.error().describe();
+  EXPECT_EQ(taken.error().describe().find("Success"), std::string::npos) << taken.error().describe();
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    EXPECT_EQ(entry.path().filename().string().find("partial"), std::string::npos) << entry.path();
+  }
 }
 
 TEST(ImageIo, TruncatedPngFromTheWildIsRejected) {
