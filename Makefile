@@ -43,7 +43,7 @@ lint: build
 	@scripts/lint.sh $(BUILD)
 
 format:
-	@git ls-files -co --exclude-standard -- '*.cpp' '*.h' | grep -E '^(runtime|devices|media|render|kiosk|sim|tests)/' | \
+	@git ls-files -co --exclude-standard -- '*.cpp' '*.h' | grep -E '^(runtime|devices|media|render|kiosk|sim|app|tools|tests)/' | \
 	  xargs clang-format-19 -i
 
 sanitize: setup
@@ -61,7 +61,7 @@ vlab: build
 	@scripts/run-tests.sh $(BUILD) -L vlab
 
 vlab-shell: setup
-	@sim/vlab/shell $(if $(wildcard $(BUILD)),--build $(BUILD))
+	@tools/vlab/shell $(if $(wildcard $(BUILD)),--build $(BUILD))
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-sanitize build-fuzz out

@@ -31,7 +31,7 @@ struct TextureView {
 
 /// \brief The texture LAVA's `texture.switch = video` puts on the object: while a texture of
 /// this name exists and the show's texture source is video, every part shows it (the scripts'
-/// VCR and camera register it, kiosk/script_player.cpp).
+/// VCR and camera register it, kiosk/show/script_player.cpp).
 inline constexpr std::string_view kVideoTexture = "lava:video";
 
 /// \brief Owns image textures and refers to stream textures, by name.

@@ -10,7 +10,7 @@ build=${1:-$top/build}
 cd "$top"
 # Logs go to a folder of this run's own: several checkouts may lint at once on one machine.
 logs=$(mktemp -d "${TMPDIR:-/tmp}/basalt-lint.XXXXXX")
-mapfile -t sources < <(git ls-files -co --exclude-standard -- '*.cpp' '*.h' | grep -E '^(runtime|devices|media|render|kiosk|sim|tests)/')
+mapfile -t sources < <(git ls-files -co --exclude-standard -- '*.cpp' '*.h' | grep -E '^(runtime|devices|media|render|kiosk|sim|app|tools|tests)/')
 status=0
 
 if [ "${LINT_FIX:-0}" = 1 ]; then

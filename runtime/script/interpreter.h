@@ -3,7 +3,7 @@
 /// \file
 /// \brief Runs a parsed `.mdl` script against a Show, one frame at a time: `step()` carries out
 /// commands until a `draw` ends the frame, the script quits, or it ends. The frame loop calls it
-/// once per frame (kiosk/script_player.h), so a script is a sequence of frames played at the
+/// once per frame (kiosk/show/script_player.h), so a script is a sequence of frames played at the
 /// show's frame rate, or as fast as possible under a ManualClock.
 ///
 /// Threading: the frame loop's thread, like the Show. Steady state allocates nothing: loops,

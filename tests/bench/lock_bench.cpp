@@ -1,4 +1,4 @@
-// Frame-locked nodes (kiosk/frame_lock.h): what the lock costs the leader per frame, beside a
+// Frame-locked nodes (kiosk/lock/frame_lock.h): what the lock costs the leader per frame, beside a
 // baseline measured in the same run.
 //  - baseline: the leader's frame without the lock (the show moved, its state captured);
 //  - alone: the same with the lock and no follower (publishing the frame and "present");
@@ -16,8 +16,8 @@
 #include <thread>
 
 #include "bench_main.h"
-#include "kiosk/frame_lock.h"
-#include "kiosk/manifest.h"
+#include "kiosk/lock/frame_lock.h"
+#include "kiosk/manifest/manifest.h"
 #include "render/output.h"
 #include "runtime/event_loop.h"
 #include "runtime/show/show.h"

@@ -23,7 +23,7 @@
 
 #include "bench_main.h"
 #include "counting_allocator.h"
-#include "kiosk/frame_loop.h"
+#include "kiosk/loop/frame_loop.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/event_loop.h"

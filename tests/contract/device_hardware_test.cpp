@@ -26,8 +26,8 @@
 #include "devices/libcamera/libcamera_camera.h"
 #include "devices/udev/udev_monitor.h"
 #include "devices/v4l2/v4l2_camera.h"
-#include "sim/vlab/uvc/usb_powermate.h"
-#include "sim/vlab/uvc/usbip.h"
+#include "tools/vlab/uvc/usb_powermate.h"
+#include "tools/vlab/uvc/usbip.h"
 #include "vlab.h"
 
 namespace basalt::devices {

@@ -7,8 +7,8 @@
 #include <span>
 #include <string_view>
 
-#include "kiosk/state_store.h"
-#include "kiosk/time_zone.h"
+#include "kiosk/manifest/time_zone.h"
+#include "kiosk/policy/state_store.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;

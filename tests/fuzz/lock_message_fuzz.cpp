@@ -1,4 +1,4 @@
-// Fuzzes the frame-lock wire format (kiosk/lock_protocol.h): what a follower reads from the
+// Fuzzes the frame-lock wire format (kiosk/lock/lock_protocol.h): what a follower reads from the
 // network and the leader from its followers. Any bytes decode to a message or an error, never a
 // crash or a read past the end; what decodes encodes back to the same bytes.
 
@@ -7,7 +7,7 @@
 #include <cstring>
 #include <span>
 
-#include "kiosk/lock_protocol.h"
+#include "kiosk/lock/lock_protocol.h"
 
 namespace {
 

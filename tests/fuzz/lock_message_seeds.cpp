@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "kiosk/lock_protocol.h"
+#include "kiosk/lock/lock_protocol.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// A manifest's views drawn by the kiosk (kiosk/display_views.h): the six facets of a cube
+// A manifest's views drawn by the kiosk (kiosk/loop/display_views.h): the six facets of a cube
 // display tiled in one output from `[[views]]` specs and a `.cave` file, compared with a golden
 // image; calibration changed live (directly and through the thesis' keys) moves the picture and
 // is saved back to the cave file, which reads back the same.
@@ -9,7 +9,7 @@
 
 #include <fstream>
 
-#include "kiosk/display_views.h"
+#include "kiosk/loop/display_views.h"
 #include "render_fixture.h"
 #include "support/polyhedra.h"
 #include "support/test_paths.h"

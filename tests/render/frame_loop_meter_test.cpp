@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "kiosk/frame_loop.h"
+#include "kiosk/loop/frame_loop.h"
 #include "render_fixture.h"
 #include "runtime/event_loop.h"
 

@@ -19,14 +19,14 @@
 #include <fstream>
 #include <thread>
 
-#include "kiosk/frame_loop.h"
-#include "kiosk/manifest.h"
-#include "kiosk/movie_item.h"
-#include "kiosk/readers.h"
-#include "kiosk/show_director.h"
-#include "kiosk/show_loader.h"
-#include "kiosk/status_board.h"
-#include "kiosk/time_zone.h"
+#include "kiosk/loop/frame_loop.h"
+#include "kiosk/manifest/manifest.h"
+#include "kiosk/manifest/time_zone.h"
+#include "kiosk/show/movie_item.h"
+#include "kiosk/show/readers.h"
+#include "kiosk/show/show_director.h"
+#include "kiosk/show/show_loader.h"
+#include "kiosk/status/status_board.h"
 #include "media/movie_probe.h"
 #include "render/output.h"
 #include "render/renderer.h"

@@ -1,5 +1,5 @@
 // Devices, cameras and movies from show manifests, headless on a ManualClock with the factories
-// of kiosk/stream_factories.h registered as `basalt run` registers them: the video-wall example
+// of kiosk/show/stream_factories.h registered as `basalt run` registers them: the video-wall example
 // plays its movie on its texture; the camera-sculpture example, with its V4L2 camera swapped for
 // the synthetic one (no V4L2 device exists here, and the test says so) and its PowerMate for a
 // replayed recording, shows the live camera; a replayed dial box turns the show through its
@@ -30,15 +30,15 @@
 #include <sstream>
 #include <thread>
 
-#include "kiosk/frame_loop.h"
-#include "kiosk/manifest.h"
-#include "kiosk/readers.h"
-#include "kiosk/script_player.h"
-#include "kiosk/show_director.h"
-#include "kiosk/show_loader.h"
-#include "kiosk/status_board.h"
-#include "kiosk/stream_factories.h"
-#include "kiosk/trace_video_glue.h"
+#include "kiosk/loop/frame_loop.h"
+#include "kiosk/manifest/manifest.h"
+#include "kiosk/show/readers.h"
+#include "kiosk/show/script_player.h"
+#include "kiosk/show/show_director.h"
+#include "kiosk/show/show_loader.h"
+#include "kiosk/show/stream_factories.h"
+#include "kiosk/show/trace_video_glue.h"
+#include "kiosk/status/status_board.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/event_loop.h"

@@ -24,8 +24,8 @@
 #include <fstream>
 #include <thread>
 
-#include "kiosk/frame_loop.h"
-#include "kiosk/supervisor.h"
+#include "kiosk/loop/frame_loop.h"
+#include "kiosk/policy/supervisor.h"
 #include "kiosk_process.h"
 #include "render/output.h"
 #include "render/renderer.h"

@@ -12,7 +12,7 @@
 #include <memory>
 #include <vector>
 
-#include "kiosk/video_streams.h"
+#include "kiosk/show/video_streams.h"
 #include "media/movie_player.h"
 #include "render/output.h"
 #include "render/renderer.h"

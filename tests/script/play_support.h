@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "kiosk/frame_loop.h"
-#include "kiosk/script_player.h"
+#include "kiosk/loop/frame_loop.h"
+#include "kiosk/show/script_player.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/image.h"

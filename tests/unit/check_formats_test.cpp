@@ -10,8 +10,8 @@
 #include <fstream>
 #include <string>
 
-#include "kiosk/check_formats.h"
-#include "kiosk/manifest.h"
+#include "kiosk/manifest/check_formats.h"
+#include "kiosk/manifest/manifest.h"
 #include "support/process.h"
 #include "support/test_paths.h"
 

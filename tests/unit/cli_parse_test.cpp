@@ -5,9 +5,9 @@
 
 #include <vector>
 
-#include "kiosk/commands.h"
-#include "kiosk/options.h"
-#include "kiosk/run_command.h"
+#include "app/commands.h"
+#include "app/options.h"
+#include "app/run_command.h"
 
 namespace basalt::kiosk {
 namespace {

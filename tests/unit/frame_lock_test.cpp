@@ -1,4 +1,4 @@
-// Frame-locked nodes (kiosk/lock_protocol.h, kiosk/frame_lock.h): the wire format, and a leader
+// Frame-locked nodes (kiosk/lock/lock_protocol.h, kiosk/lock/frame_lock.h): the wire format, and a leader
 // with followers over ZeroMQ on loopback, each node on its own thread, without rendering.
 
 #include <gtest/gtest.h>
@@ -14,11 +14,11 @@
 #include <thread>
 #include <vector>
 
-#include "kiosk/frame_lock.h"
-#include "kiosk/lock_protocol.h"
-#include "kiosk/manifest.h"
-#include "kiosk/status_board.h"
-#include "kiosk/status_report.h"
+#include "kiosk/lock/frame_lock.h"
+#include "kiosk/lock/lock_protocol.h"
+#include "kiosk/manifest/manifest.h"
+#include "kiosk/status/status_board.h"
+#include "kiosk/status/status_report.h"
 #include "render/output.h"
 #include "runtime/event_loop.h"
 #include "runtime/show/show.h"

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "kiosk/kiosk_policy.h"
-#include "kiosk/schedule.h"
+#include "kiosk/policy/kiosk_policy.h"
+#include "kiosk/policy/schedule.h"
 #include "runtime/clock.h"
 
 namespace basalt::kiosk {

@@ -15,10 +15,10 @@
 #include <string>
 #include <thread>
 
-#include "kiosk/check_command.h"
-#include "kiosk/manifest.h"
-#include "kiosk/show_loader.h"
-#include "kiosk/stream_factories.h"
+#include "app/check_command.h"
+#include "kiosk/manifest/manifest.h"
+#include "kiosk/show/show_loader.h"
+#include "kiosk/show/stream_factories.h"
 #include "runtime/unique_fd.h"
 #include "support/process.h"
 #include "support/test_paths.h"

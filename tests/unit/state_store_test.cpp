@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "kiosk/state_store.h"
+#include "kiosk/policy/state_store.h"
 #include "support/test_paths.h"
 
 namespace basalt::kiosk {

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "kiosk/status_board.h"
-#include "kiosk/status_report.h"
+#include "kiosk/status/status_board.h"
+#include "kiosk/status/status_report.h"
 
 namespace basalt::kiosk {
 namespace {

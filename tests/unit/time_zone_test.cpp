@@ -11,7 +11,7 @@
 #include <fstream>
 #include <vector>
 
-#include "kiosk/time_zone.h"
+#include "kiosk/manifest/time_zone.h"
 
 namespace basalt::kiosk {
 namespace {

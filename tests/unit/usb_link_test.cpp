@@ -1,4 +1,4 @@
-// The transports of the virtual lab's emulated USB devices (sim/vlab/uvc): USB/IP as vhci_hcd
+// The transports of the virtual lab's emulated USB devices (tools/vlab/uvc): USB/IP as vhci_hcd
 // speaks it and usbredir as qemu's usb-redir speaks it. Each test plays the host side over a
 // socket pair, byte for byte as the protocol documents describe it, against the lab's UVC camera.
 // The same code runs against the real kernel and the real qemu in the virtual lab
@@ -16,9 +16,9 @@
 
 #include "runtime/clock.h"
 #include "runtime/unique_fd.h"
-#include "sim/vlab/uvc/usbip.h"
-#include "sim/vlab/uvc/usbredir.h"
-#include "sim/vlab/uvc/uvc_camera.h"
+#include "tools/vlab/uvc/usbip.h"
+#include "tools/vlab/uvc/usbredir.h"
+#include "tools/vlab/uvc/uvc_camera.h"
 
 namespace basalt::sim::vlab {
 namespace {

@@ -1,10 +1,10 @@
-// The virtual lab's UVC camera (sim/vlab/uvc): its test picture and frame counter, its JPEG
+// The virtual lab's UVC camera (tools/vlab/uvc): its test picture and frame counter, its JPEG
 // encoder (checked with a real decoder, OpenImageIO's), its payloads (reassembled the way Linux's
 // uvcvideo reassembles a bulk stream), its descriptors and its control requests. The camera's
 // life with a real kernel is tested in the virtual lab (tests/vlab/lab_selftest.cpp); these
 // tests pin down the behaviour that the lab's tests rely on, quickly and without qemu.
 
-#include "sim/vlab/uvc/uvc_camera.h"
+#include "tools/vlab/uvc/uvc_camera.h"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 
 #include "media/image_io.h"
 #include "sim/jpeg_encoder.h"
-#include "sim/vlab/uvc/test_picture.h"
 #include "support/test_paths.h"
+#include "tools/vlab/uvc/test_picture.h"
 
 namespace basalt::sim::vlab {
 namespace {

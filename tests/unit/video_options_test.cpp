@@ -8,8 +8,8 @@
 #include <string_view>
 #include <vector>
 
-#include "kiosk/run_command.h"
-#include "kiosk/video_streams.h"
+#include "app/run_command.h"
+#include "kiosk/show/video_streams.h"
 
 namespace basalt::kiosk {
 namespace {

@@ -1,5 +1,5 @@
 // The virtual lab's self-tests: run inside the lab (ctest `vlab/basalt_vlab_selftest/...`),
-// they check from the guest that every fixture of the environment contract (sim/vlab/README.md)
+// they check from the guest that every fixture of the environment contract (tools/vlab/README.md)
 // is really there and works, so that a real-backend test that fails in the lab fails because of
 // Basalt, not because of the lab. Outside the lab each test skips, saying so.
 //
@@ -29,11 +29,11 @@
 #include "runtime/unique_fd.h"
 #include "sim/hid_recording.h"
 #include "sim/jpeg_encoder.h"
-#include "sim/vlab/uhid_device.h"
-#include "sim/vlab/uvc/test_picture.h"
-#include "sim/vlab/uvc/uvc_camera.h"
 #include "support/process.h"
 #include "support/test_paths.h"
+#include "tools/vlab/uhid_device.h"
+#include "tools/vlab/uvc/test_picture.h"
+#include "tools/vlab/uvc/uvc_camera.h"
 
 namespace basalt {
 namespace {
@@ -137,7 +137,7 @@ test::ProcessResult gadgetCtl(const std::string& action, const std::string& devi
   return test::run({env("BASALT_VLAB_GADGET_CTL"), action, device}, {}, 30s);
 }
 
-// The lab's dial box report descriptor, as documented in sim/vlab/README.md: 8 buttons, then 8
+// The lab's dial box report descriptor, as documented in tools/vlab/README.md: 8 buttons, then 8
 // relative signed-byte dials X, Y, Z, Rx, Ry, Rz, Dial, Wheel.
 const std::vector<std::uint8_t> kDialDescriptor = {
     0x05, 0x01, 0x09, 0x08, 0xa1, 0x01, 0x05, 0x09, 0x19, 0x01, 0x29, 0x08, 0x15, 0x00, 0x25, 0x01, 0x75,

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The virtual lab runner's failure modes (sim/vlab/vlab.py), each reported as such and never a
+"""The virtual lab runner's failure modes (tools/vlab/vlab.py), each reported as such and never a
 hang: a test binary that crashes inside the lab, a lab that does not boot within its time-out,
 a missing kernel package, no free disk. Example failure: a crash inside the guest reads as a
 pass because the runner only looked at qemu's exit status.
@@ -13,7 +13,7 @@ import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-TOOL = os.path.join(os.path.dirname(os.path.dirname(HERE)), "sim", "vlab", "vlab.py")
+TOOL = os.path.join(os.path.dirname(os.path.dirname(HERE)), "tools", "vlab", "vlab.py")
 failures = []
 
 

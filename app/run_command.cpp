@@ -1,0 +1,852 @@
+#include "app/run_command.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <system_error>
+
+#include <fmt/format.h>
+#include <fmt/std.h>
+
+#include "app/commands.h"
+#include "app/options.h"
+#include "devices/evdev/evdev_input.h"
+#include "kiosk/lock/frame_lock.h"
+#include "kiosk/loop/display_views.h"
+#include "kiosk/loop/frame_loop.h"
+#include "kiosk/manifest/manifest.h"
+#include "kiosk/policy/state_store.h"
+#include "kiosk/policy/supervisor.h"
+#include "kiosk/show/device_wiring.h"
+#include "kiosk/show/readers.h"
+#include "kiosk/show/script_player.h"
+#include "kiosk/show/show_director.h"
+#include "kiosk/show/show_loader.h"
+#include "kiosk/show/stream_factories.h"
+#include "kiosk/show/trace_video_glue.h"
+#include "kiosk/status/frame_metrics.h"
+#include "kiosk/status/status_board.h"
+#include "kiosk/status/status_server.h"
+#include "media/image_io.h"
+#include "media/net_clock.h"
+#include "render/output.h"
+#include "render/renderer.h"
+#include "runtime/event_loop.h"
+#include "runtime/image.h"
+#include "runtime/log.h"
+#include "runtime/script/interpreter.h"
+#include "runtime/script/save_model.h"
+#include "runtime/show/show.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Run, "kiosk");
+
+namespace {
+
+int failWith(const Error& error, std::string_view what) {
+  fmt::print(stderr, "basalt: error: {}: {}\n", what, error.describe());
+  return 1;
+}
+
+/// Makes sure snapshots can be written before anything is rendered.
+Result<void> checkWritableFolder(const std::filesystem::path& file) {
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (ec) {
+    return fail(Errc::kIo, fmt::format("cannot create the output folder {}: {}; choose another with "
+                                       "--output-dir or --snapshot",
+                                       folder, ec.message()));
+  }
+  if (::access(folder.c_str(), W_OK) != 0) {
+    return fail(Errc::kPermissionDenied,
+                fmt::format("the output folder {} is not writable ({}); choose another with --output-dir or "
+                            "--snapshot",
+                            folder, std::strerror(errno)));
+  }
+  return {};
+}
+
+constexpr std::uint32_t kMaxDimension = 16384;
+
+Result<void> parseSize(std::string_view text, RunOptions& run) {
+  const auto x = text.find_first_of("xX");
+  const auto bad = [&] {
+    return fail(
+        Errc::kInvalidArgument,
+        fmt::format("--size needs WIDTHxHEIGHT between 1 and {} each, e.g. 1280x720, not '{}'", kMaxDimension, text));
+  };
+  if (x == std::string_view::npos) return bad();
+  auto w = integerOption("--size", text.substr(0, x), 1, kMaxDimension);
+  auto h = integerOption("--size", text.substr(x + 1), 1, kMaxDimension);
+  if (!w || !h) return bad();
+  run.width = static_cast<std::uint32_t>(*w);
+  run.height = static_cast<std::uint32_t>(*h);
+  return {};
+}
+
+}  // namespace
+
+std::string_view runUsage() {
+  return R"(Usage: basalt run [options] [show.toml | SCRIPT.mdl]
+
+Plays a show. With a show manifest (show.toml, see configs/shows/) it plays that show: its
+outputs, entry, devices and bindings, textures, kiosk policy (opening hours, attract loop,
+playlist) and status server. With none it plays the default show: LAVA's start-up scene, a
+coloured cube on black, 500x500, turning slowly under LAVA's default lights.
+The output is the manifest's, or detected: KMS when Basalt can be DRM master (no desktop
+running), a window when a display server is there, offscreen (headless) otherwise; the
+headless output writes a snapshot of the last frame.
+Without --frames or --seconds it runs until interrupted (Ctrl-C, SIGTERM) and exits cleanly.
+SIGHUP re-reads the manifest; the show plays on until the new one is ready.
+
+SHOW may be a LAVA script (.mdl), run as `lava -file SHOW.mdl` ran it: each `draw` is one
+frame, `quit` ends the run, and a bad line is reported and skipped while the show goes on.
+A script that quits runs as fast as possible on the manual clock unless --realtime is given.
+'basalt help script' lists the language; 'basalt check SHOW.mdl' finds errors without running.
+
+Options:
+  --frames N         stop after N frames
+  --seconds S        stop after S seconds of show time
+  --size WxH         output size in pixels (default: the manifest's, or 500x500)
+  --output KIND      auto, headless, kms or window (default: the manifest's, or auto)
+  --headless         render offscreen even when a display is available (--output headless)
+  --snapshot PATH    write the last frame to PATH (format from the extension: .png, .jpg,
+                     .tif, .exr, ...); default: OUTPUT_DIR/snapshot.png
+  --output-dir DIR   folder for snapshots (default: out)
+  --fps F            show frame rate (default: the manifest's, or 60)
+  --realtime         pace frames on the system clock at the frame rate
+  --fast             step a manual clock exactly 1/fps per frame and render as fast as
+                     possible (the default headless when --frames or --seconds is given)
+  --save-image PATH  where a script's save_image writes (default: OUTPUT_DIR/ras.im32)
+  --save-model PATH  at the end, write the show as a LAVA script (LAVA's Save Model)
+  --movie PART=FILE  play FILE as the texture of PART (LAVA's texture.switch = video),
+                     looping with no gap; repeat the option for more streams, or for the
+                     same PART to make a playlist
+  --movie-once       play movies once instead of looping
+  --zoom PART[=SCALE][@X,Y]
+                     show PART's movie as a picture over the scene (LAVA's Zoom): SCALE of
+                     its size (default 0.5), top-left corner at X,Y pixels (default 10,10)
+  --zoom-dials X,Y   dials X and Y move the Zoom pictures across and down (LAVA's Shift +
+                     drag), a full turn the output's width or height; with --replay
+  --audio            play the movies' sound on the default output
+  --record PATH      record the rendered output to PATH (.mp4, .mkv, .mov, .avi, .webm)
+  --record-codec C   h264, mjpeg, vp8, vp9 or auto (H.264; MJPEG for .avi; VP9 for .webm)
+  --record-frames N  stop recording after N frames (LAVA's Rec slider); default: the run
+  --replay PATH      play the devices recorded in a trace folder (basalt record) or an
+                     hid-recorder file as if they were plugged in; dials drive LAVA's dial table
+  --replay-once      play the recording once instead of looping
+  --clock-start T    with --fast: the calendar time the show starts at, for trying opening
+                     hours (2026-12-24T09:59:00Z)
+  --status ADDR:PORT serve status and controls there (default: the manifest's [status];
+                     port 0 picks a free one)
+  --state-dir DIR    where the show's resume point is kept (default: $STATE_DIRECTORY,
+                     else ~/.local/state/basalt)
+  --no-resume        start from the beginning, not where the show was before it stopped
+  -h, --help         this text
+
+Exit status: 0 when the show ran, 1 when it could not start or failed, 2 for usage errors.
+)";
+}
+
+namespace {
+
+Result<WallTime> parseClockStart(std::string_view text) {
+  // 2026-12-24T09:59:00Z (UTC).
+  const auto bad = [&] {
+    return fail(Errc::kInvalidArgument,
+                fmt::format("--clock-start needs a UTC time like 2026-12-24T09:59:00Z, not '{}'", text));
+  };
+  if (text.size() != 20 || text[10] != 'T' || text[19] != 'Z') return bad();
+  auto date = parseDate(text.substr(0, 10));
+  auto h = integerOption("--clock-start", text.substr(11, 2), 0, 23);
+  auto m = integerOption("--clock-start", text.substr(14, 2), 0, 59);
+  auto sec = integerOption("--clock-start", text.substr(17, 2), 0, 59);
+  if (!date || !h || !m || !sec || text[13] != ':' || text[16] != ':') return bad();
+  const std::int64_t days = daysFromCivil(date->year, date->month, date->day);
+  return WallTime{std::chrono::seconds(days * 86400 + *h * 3600 + *m * 60 + *sec)};
+}
+
+}  // namespace
+
+Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
+  auto parsed = parseOptions("run", args,
+                             {{"--help|-h"},
+                              {"--frames", true},
+                              {"--seconds", true},
+                              {"--size", true},
+                              {"--output", true},
+                              {"--headless"},
+                              {"--snapshot", true},
+                              {"--output-dir", true},
+                              {"--fps", true},
+                              {"--realtime"},
+                              {"--fast"},
+                              {"--save-image", true},
+                              {"--save-model", true},
+                              {"--movie", true},
+                              {"--movie-once"},
+                              {"--zoom", true},
+                              {"--zoom-dials", true},
+                              {"--audio"},
+                              {"--record", true},
+                              {"--record-codec", true},
+                              {"--record-frames", true},
+                              {"--replay", true},
+                              {"--replay-once"},
+                              {"--clock-start", true},
+                              {"--status", true},
+                              {"--state-dir", true},
+                              {"--no-resume"}});
+  if (!parsed) return std::unexpected(parsed.error());
+  RunOptions run;
+  for (const ParsedOption& o : *parsed) {
+    if (o.name.empty()) {
+      if (run.manifest || run.show) {
+        return fail(Errc::kInvalidArgument, fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
+                                                        (run.manifest ? *run.manifest : *run.show).string()));
+      }
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
+      if (o.value.ends_with(".toml")) {
+        run.manifest = std::filesystem::path(o.value);
+      } else {
+        run.show = std::filesystem::path(o.value);  // a LAVA script; runShow says if it is not one
+      }
+      continue;
+    }
+    if (o.name == "--help") {
+      run.help = true;
+    } else if (o.name == "--frames") {
+      auto n = integerOption(o.name, o.value, 1, INT64_MAX);
+      if (!n) return std::unexpected(n.error());
+      run.frames = *n;
+    } else if (o.name == "--seconds") {
+      auto v = numberOption(o.name, o.value, 1e-6, 1e9);
+      if (!v) return std::unexpected(v.error());
+      run.seconds = *v;
+    } else if (o.name == "--size") {
+      if (auto r = parseSize(o.value, run); !r) return std::unexpected(r.error());
+      run.sizeGiven = true;
+    } else if (o.name == "--output") {
+      static constexpr std::pair<std::string_view, render::OutputKind> kKinds[] = {
+          {"auto", render::OutputKind::kAuto},
+          {"headless", render::OutputKind::kHeadless},
+          {"kms", render::OutputKind::kKms},
+          {"window", render::OutputKind::kWindow}};
+      const auto* it =
+          std::find_if(std::begin(kKinds), std::end(kKinds), [&](const auto& k) { return k.first == o.value; });
+      if (it == std::end(kKinds)) {
+        return fail(Errc::kInvalidArgument,
+                    fmt::format("--output must be auto, headless, kms or window, not '{}'", o.value));
+      }
+      run.output = it->second;
+      run.headless = it->second == render::OutputKind::kHeadless;
+    } else if (o.name == "--headless") {
+      run.headless = true;
+      run.output = render::OutputKind::kHeadless;
+    } else if (o.name == "--snapshot") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--snapshot needs a file name");
+      run.snapshot = std::filesystem::path(o.value);
+    } else if (o.name == "--output-dir") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--output-dir needs a folder");
+      run.outputDir = std::filesystem::path(o.value);
+    } else if (o.name == "--fps") {
+      auto v = numberOption(o.name, o.value, 1, 1000);
+      if (!v) return std::unexpected(v.error());
+      run.fps = *v;
+      run.fpsGiven = true;
+    } else if (o.name == "--realtime") {
+      run.clock = ClockMode::kSystem;
+    } else if (o.name == "--fast") {
+      run.clock = ClockMode::kManual;
+    } else if (o.name == "--save-image") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--save-image needs a file name");
+      run.saveImage = std::filesystem::path(o.value);
+    } else if (o.name == "--save-model") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--save-model needs a file name");
+      run.saveModel = std::filesystem::path(o.value);
+    } else if (o.name == "--movie") {
+      auto m = parseMovieOption(o.value);
+      if (!m) return std::unexpected(m.error());
+      run.movies.push_back(std::move(*m));
+    } else if (o.name == "--movie-once") {
+      run.movieOnce = true;
+    } else if (o.name == "--zoom") {
+      auto z = parseZoomOption(o.value);
+      if (!z) return std::unexpected(z.error());
+      run.zooms.push_back(std::move(*z));
+    } else if (o.name == "--zoom-dials") {
+      int x = -1;
+      int y = -1;
+      const auto comma = o.value.find(',');
+      const auto number = [](std::string_view t, int& out) {
+        const auto r = std::from_chars(t.data(), t.data() + t.size(), out);
+        return r.ec == std::errc{} && r.ptr == t.data() + t.size() && out >= 0 &&
+               out < static_cast<int>(runtime::kMaxBoundDials);
+      };
+      if (comma == std::string_view::npos || !number(o.value.substr(0, comma), x) ||
+          !number(o.value.substr(comma + 1), y) || x == y) {
+        return fail(Errc::kInvalidArgument,
+                    fmt::format("--zoom-dials needs two different dial numbers from 0 to {}, like 6,7 (got '{}')",
+                                runtime::kMaxBoundDials - 1, o.value));
+      }
+      run.zoomDials = std::pair{x, y};
+    } else if (o.name == "--audio") {
+      run.audio = true;
+    } else if (o.name == "--record") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--record needs a file name");
+      run.record = std::filesystem::path(o.value);
+    } else if (o.name == "--record-codec") {
+      auto c = media::parseVideoCodec(o.value);
+      if (!c) return std::unexpected(c.error());
+      run.recordCodec = std::string(o.value);
+    } else if (o.name == "--record-frames") {
+      auto n = integerOption(o.name, o.value, 1, INT64_MAX);
+      if (!n) return std::unexpected(n.error());
+      run.recordFrames = *n;
+    } else if (o.name == "--replay") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--replay needs a trace folder or .hid file");
+      run.replay = std::filesystem::path(o.value);
+    } else if (o.name == "--replay-once") {
+      run.replayOnce = true;
+    } else if (o.name == "--clock-start") {
+      auto t = parseClockStart(o.value);
+      if (!t) return std::unexpected(t.error());
+      run.clockStart = *t;
+    } else if (o.name == "--status") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--status needs ADDRESS:PORT, e.g. 127.0.0.1:8180");
+      run.statusListen = std::string(o.value);
+    } else if (o.name == "--state-dir") {
+      if (o.value.empty()) return fail(Errc::kInvalidArgument, "--state-dir needs a folder");
+      run.stateDir = std::filesystem::path(o.value);
+    } else if (o.name == "--no-resume") {
+      run.resume = false;
+    }
+  }
+  for (const auto& [name, zoom] : run.zooms) {
+    const bool known =
+        std::any_of(run.movies.begin(), run.movies.end(), [&](const auto& m) { return m.first == name; });
+    if (!known) {
+      return fail(Errc::kInvalidArgument,
+                  fmt::format("--zoom {}: no movie of that name; give --movie {}=FILE too", name, name));
+    }
+  }
+  if (run.zoomDials && run.zooms.empty()) {
+    return fail(Errc::kInvalidArgument, "--zoom-dials moves the Zoom picture: give --zoom PART too");
+  }
+  return run;
+}
+
+int runMain(std::span<const std::string_view> args) {
+  auto options = parseRunOptions(args);
+  if (!options) return usageError(options.error().describe());
+  if (options->help) {
+    fmt::print("{}", runUsage());
+    return 0;
+  }
+  return runShow(*options);
+}
+
+namespace {
+
+std::string_view kindName(render::OutputKind kind) {
+  switch (kind) {
+    case render::OutputKind::kAuto: return "auto";
+    case render::OutputKind::kHeadless: return "headless";
+    case render::OutputKind::kKms: return "kms";
+    case render::OutputKind::kWindow: return "window";
+  }
+  return "?";
+}
+
+render::OutputKind toRenderKind(OutputKind kind) {
+  switch (kind) {
+    case OutputKind::kAuto: return render::OutputKind::kAuto;
+    case OutputKind::kHeadless: return render::OutputKind::kHeadless;
+    case OutputKind::kKms: return render::OutputKind::kKms;
+    case OutputKind::kWindow: return render::OutputKind::kWindow;
+  }
+  return render::OutputKind::kAuto;
+}
+
+/// Reads and validates the manifest (the files it names must exist inside the show folder; their
+/// contents are read as the show loads them, and `basalt check` parses them all beforehand);
+/// prints its errors and warnings.
+std::optional<Manifest> readShowManifest(const std::filesystem::path& file) {
+  Diagnostics diagnostics;
+  auto manifest = readManifest(file, diagnostics);
+  for (const Diagnostic& d : diagnostics.items()) {
+    if (d.severity != Severity::kNote) fmt::print(stderr, "{}\n", d.format());
+  }
+  if (!manifest) {
+    fmt::print(stderr,
+               "basalt: error: cannot start: {} has {} problem{} (above); 'basalt check {}' lists them without "
+               "starting\n",
+               file.string(), diagnostics.errorCount(), diagnostics.errorCount() == 1 ? "" : "s", file.string());
+  }
+  return manifest;
+}
+
+/// "127.0.0.1:8180" or "[::1]:0" into the status spec.
+Result<void> applyStatusListen(std::string_view listen, StatusSpec& spec) {
+  std::string_view host;
+  std::string_view port;
+  if (listen.starts_with('[')) {
+    const auto close = listen.find("]:");
+    if (close == std::string_view::npos) return fail(Errc::kInvalidArgument, "--status needs [ADDRESS]:PORT");
+    host = listen.substr(1, close - 1);
+    port = listen.substr(close + 2);
+  } else {
+    const auto colon = listen.rfind(':');
+    if (colon == std::string_view::npos) return fail(Errc::kInvalidArgument, "--status needs ADDRESS:PORT");
+    host = listen.substr(0, colon);
+    port = listen.substr(colon + 1);
+  }
+  auto p = integerOption("--status", port, 0, 65535);
+  if (!p) return std::unexpected(p.error());
+  spec.enabled = true;
+  spec.host = std::string(host);
+  spec.port = static_cast<std::uint16_t>(*p);
+  if (!spec.loopbackOnly() && spec.token.empty() && spec.tokenFile.empty()) {
+    return fail(Errc::kInvalidArgument, fmt::format("--status {} opens the server beyond this machine; that needs a "
+                                                    "token (status.token_file in show.toml)",
+                                                    listen));
+  }
+  return {};
+}
+
+/// The lock's view of the network clock: its offset from this node's own clock.
+class NetClockProbe final : public LockClockProbe {
+ public:
+  explicit NetClockProbe(const media::NetClock& clock) : clock_(clock) {}
+  [[nodiscard]] Nanos offset() const override { return clock_.offset(); }
+
+ private:
+  const media::NetClock& clock_;
+};
+
+std::string hostName() {
+  std::array<char, 256> name{};
+  if (::gethostname(name.data(), name.size() - 1) != 0) return "node";
+  std::string n(name.data());
+  if (n.size() > 32) n.resize(32);
+  return n;
+}
+
+}  // namespace
+
+int runShow(const RunOptions& options) {
+  registerContentReaders();
+  Manifest manifest = Manifest::builtinDefault();
+  if (options.manifest) {
+    auto read = readShowManifest(*options.manifest);
+    if (!read) return 1;
+    manifest = std::move(*read);
+  }
+  if (stderrIsJournal()) logToJournal(manifest.name);
+
+  const std::filesystem::path snapshotPath = options.snapshot ? *options.snapshot : options.outputDir / "snapshot.png";
+  if (options.show && !isScriptFile(*options.show)) {
+    return usageError(
+        fmt::format("basalt run plays show manifests and LAVA scripts (.mdl); '{}' is neither: give a show manifest "
+                    "(show.toml) or a script",
+                    options.show->string()));
+  }
+  if (auto r = checkWritableFolder(snapshotPath); !r) return failWith(r.error(), "cannot start");
+  if (options.statusListen) {
+    if (auto r = applyStatusListen(*options.statusListen, manifest.status); !r)
+      return failWith(r.error(), "cannot start");
+  }
+
+  std::optional<script::Interpreter> script;
+  if (options.show) {
+    auto loaded = loadScript(*options.show);
+    if (!loaded) return failWith(loaded.error(), "cannot start");
+    script.emplace(std::move(*loaded));
+  }
+
+  const double fps = options.fpsGiven || !options.manifest ? options.fps : manifest.fps;
+  std::int64_t maxFrames = -1;
+  if (options.frames) maxFrames = *options.frames;
+  if (options.seconds) {
+    const auto fromSeconds = static_cast<std::int64_t>(std::ceil(*options.seconds * fps));
+    maxFrames = maxFrames < 0 ? fromSeconds : std::min(maxFrames, fromSeconds);
+  }
+  // A script that quits is a batch job (LAVA's test scripts): it runs as fast as it can.
+  const bool batch = maxFrames >= 0 || (script && scriptQuits(script->program()));
+  const bool manual = options.clock == ClockMode::kManual || (options.clock == ClockMode::kAuto && batch);
+  SystemClock systemClock;
+  ManualClock manualClock(Nanos{0}, options.clockStart ? *options.clockStart : systemClock.wallNow());
+  // Frame-locked nodes share the leader's clock (GStreamer's network clock): the leader serves
+  // its monotonic clock, a follower paced in real time reads it as its show clock.
+  const LockSpec& lockSpec = manifest.lock;
+  std::unique_ptr<media::NetClockServer> clockServer;
+  std::unique_ptr<media::NetClock> netClock;
+  if (lockSpec.role != LockRole::kOff && lockSpec.clock) {
+    // The shared clock's GStreamer threads start here, before the event loop watches the stop
+    // signals: block those now so that the threads inherit the mask. Otherwise a SIGTERM could
+    // land on a clock thread, whose default action ends the process without its summary.
+    sigset_t stopSignals;
+    sigemptyset(&stopSignals);
+    for (const int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&stopSignals, s);
+    (void)pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
+  }
+  if (lockSpec.role == LockRole::kLeader && lockSpec.clock) {
+    auto served = media::NetClockServer::start(lockSpec.listen, lockSpec.port + 2);
+    if (!served) return failWith(served.error(), "cannot share the clock");
+    clockServer = std::move(*served);
+  } else if (lockSpec.role == LockRole::kFollower && lockSpec.clock) {
+    auto followed = media::NetClock::connect(lockSpec.leader, lockSpec.port + 2);
+    if (!followed) return failWith(followed.error(), "cannot follow the leader's clock");
+    netClock = std::move(*followed);
+    if (!netClock->waitForSync(std::chrono::seconds(2))) {
+      log::warn(kLogRun, "the leader's clock at {}:{} did not answer within 2 s; following it when it does",
+                lockSpec.leader, lockSpec.port + 2);
+    }
+  }
+  const Clock& clock = manual     ? static_cast<const Clock&>(manualClock)
+                       : netClock ? static_cast<const Clock&>(*netClock)
+                                  : static_cast<const Clock&>(systemClock);
+
+  auto loop = runtime::EventLoop::create(clock);
+  if (!loop) return failWith(loop.error(), "cannot start the event loop");
+  // Signals are blocked before any thread starts (the state writer, the status server, the
+  // renderer's), so that every thread inherits the mask and only the loop receives them.
+  FrameLoop* stopTarget = nullptr;
+  ShowDirector* reloadTarget = nullptr;
+  bool stopBeforeLoop = false;
+  auto signals = (*loop)->watchSignals({SIGINT, SIGTERM, SIGHUP}, [&](int signal) {
+    if (signal == SIGHUP) {
+      if (reloadTarget) reloadTarget->requestReload();
+    } else if (stopTarget) {
+      stopTarget->requestStop();
+    } else {
+      stopBeforeLoop = true;
+    }
+  });
+  if (!signals) return failWith(signals.error(), "cannot watch for signals");
+
+  render::OutputRequest request;
+  request.kind = options.output ? *options.output : toRenderKind(manifest.output.kind);
+  request.size = {options.width, options.height};
+  if (!options.sizeGiven && manifest.output.width > 0) request.size = {manifest.output.width, manifest.output.height};
+  request.drmDevice = manifest.output.device;
+  request.connector = manifest.output.connector;
+  if (manifest.output.mode) {
+    request.mode =
+        render::ModeWish{manifest.output.mode->width, manifest.output.mode->height, manifest.output.mode->refresh};
+  }
+  request.fullscreen = manifest.output.fullscreen;
+  request.title = "Basalt: " + manifest.name;
+  std::string passedOver;
+  auto output = render::openOutput(request, &passedOver);
+  if (!output) {
+    return failWith(output.error(), fmt::format("cannot open the {} output", request.kind == render::OutputKind::kAuto
+                                                                                 ? std::string_view("headless")
+                                                                                 : kindName(request.kind)));
+  }
+  if (!passedOver.empty()) {
+    std::string_view lines = passedOver;
+    while (!lines.empty()) {
+      const auto nl = lines.find('\n');
+      log::info(kLogRun, "output passed over: {}", lines.substr(0, nl));
+      lines = nl == std::string_view::npos ? std::string_view{} : lines.substr(nl + 1);
+    }
+  }
+  auto renderer = render::Renderer::create();
+  if (!renderer) return failWith(renderer.error(), "cannot set up the renderer");
+
+  StatusBoard board(systemClock.wallNow(), fps);
+  runtime::EventLoop* eventLoop = loop->get();
+  board.setWake([eventLoop] { eventLoop->wake(); });
+  BoundedQueue<Event> events(1024, [eventLoop] { eventLoop->wake(); });
+  auto supervisor = Supervisor::fromEnvironment();
+
+  std::unique_ptr<StateStore> state;
+  std::optional<ResumePoint> resume;
+  if (options.manifest && manifest.kiosk.resume && options.resume) {
+    const std::filesystem::path folder = options.stateDir ? *options.stateDir : defaultStateFolder();
+    auto store = StateStore::open(folder, manifest.file.string());
+    if (store) {
+      state = std::move(*store);
+      resume = state->load();
+    } else {
+      log::warn(kLogRun, "{}; the show will not resume after a restart", store.error().message());
+    }
+  }
+
+  // Texture images are read in the background: the first frame does not wait for them.
+  registerShowFactories();  // hid and replay dial boxes, movie and camera streams
+  auto loaded = loadShow(manifest, clock, false);
+  if (!loaded) return failWith(loaded.error(), "cannot load the show");
+
+  runtime::Show show;
+  FrameLoop frameLoop({fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output, **renderer);
+  ShowDirector director(
+      DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps});
+  director.install(std::move(*loaded), clock.now(), resume);
+  // Keyboards and mice where no window delivers them (KMS): read from evdev on a thread of their
+  // own, taken by the director each frame the way a window's keys are.
+  std::unique_ptr<devices::EvdevInput> keyboardsAndMice;
+  const EvdevMode evdevMode = manifest.input.evdev;
+  if (evdevMode == EvdevMode::kOn || (evdevMode == EvdevMode::kAuto && (*output)->kind() == "kms")) {
+    devices::EvdevOptions evdevOptions;
+    evdevOptions.keyboards = manifest.input.keyboards;
+    evdevOptions.pointers = manifest.input.pointers;
+    evdevOptions.names = manifest.input.names;
+    auto made = devices::EvdevInput::create(clock, std::move(evdevOptions), [eventLoop] { eventLoop->wake(); });
+    if (made) {
+      keyboardsAndMice = std::move(*made);
+      keyboardsAndMice->start();
+      director.setKeyboardsAndMice(keyboardsAndMice.get());
+    } else {
+      log::warn(kLogRun, "{}; keyboards and mice are not read", made.error().describe());
+    }
+  }
+  if (script) show = script::startupShow();  // a script starts from LAVA's start-up state
+
+  stopTarget = &frameLoop;
+  reloadTarget = &director;
+  if (stopBeforeLoop) frameLoop.requestStop();
+
+  std::unique_ptr<StatusServer> server;
+  if (manifest.status.enabled) {
+    auto started = StatusServer::start(manifest.status, board);
+    if (started) {
+      server = std::move(*started);
+      fmt::print("basalt: status server: {}\n", server->url());
+      std::fflush(stdout);
+    } else {
+      // The show matters more than its status page.
+      log::error(kLogRun, "{}; the show plays without it", started.error().describe());
+    }
+  }
+
+  // [[views]]: facets of an immersive display, stereo eyes, tiles (one plain view without).
+  std::unique_ptr<DisplayViews> views;
+  if (!manifest.views.empty()) {
+    auto made = DisplayViews::create(manifest.views, **renderer, (*output)->size());
+    if (!made) return failWith(made.error(), "cannot set up the show's views");
+    views = std::move(*made);
+    frameLoop.setViewDrawer(views.get());
+    director.setViews(views.get());
+  }
+
+  FrameMetrics metrics(board, &events, (*output)->describe());
+  frameLoop.addParticipant(metrics);
+  frameLoop.addParticipant(director);
+  frameLoop.addParticipant(*supervisor);
+
+  std::optional<ScriptPlayer> player;
+  if (script) {
+    ScriptPlayerOptions playerOptions;
+    setScriptVcrOptions(playerOptions, manifest, clock);
+    playerOptions.outputDir = options.outputDir;
+    if (options.saveImage) playerOptions.saveImage = *options.saveImage;
+    player.emplace(std::move(*script), show, **renderer, std::move(playerOptions));
+    player->setReporter(printScriptDiagnostic);
+    frameLoop.addParticipant(*player);
+  }
+
+  // Movies: GStreamer starts only when a show has some (start-up stays fast without).
+  std::unique_ptr<VideoStreams> videos;
+  if (!options.movies.empty()) {
+    std::vector<MovieStreamSpec> specs;
+    for (const auto& [name, file] : options.movies) {
+      auto same = std::find_if(specs.begin(), specs.end(), [&](const MovieStreamSpec& s) { return s.name == name; });
+      if (same == specs.end()) {
+        specs.push_back({name, {file}, !options.movieOnce, options.audio, std::nullopt});
+      } else {
+        same->files.push_back(file);  // the same part again: a playlist
+      }
+    }
+    for (const auto& [name, zoom] : options.zooms) {
+      for (MovieStreamSpec& s : specs) {
+        if (s.name == name) s.zoom = zoom;
+      }
+    }
+    auto v = VideoStreams::create(specs, show, **renderer, manual);
+    if (!v) return failWith(v.error(), "cannot start the movies");
+    videos = std::move(*v);
+    frameLoop.addParticipant(*videos);
+  }
+  // Recording comes after the movies so that it sees the Zoom pictures.
+  std::unique_ptr<ScreenRecorder> recorder;
+  if (options.record) {
+    media::RecorderOptions ro;
+    ro.path = *options.record;
+    ro.width = (*output)->size().width;
+    ro.height = (*output)->size().height;
+    ro.fps = fps;
+    ro.codec = *media::parseVideoCodec(options.recordCodec);
+    ro.maxFrames = options.recordFrames.value_or(-1);
+    ro.waitForEncoder = manual;  // offline runs keep every frame; live shows drop rather than wait
+    auto r = ScreenRecorder::create(ro);
+    if (!r) return failWith(r.error(), "cannot record");
+    recorder = std::move(*r);
+    frameLoop.addParticipant(*recorder);
+  }
+  // Devices: a replayed trace drives the show through LAVA's dial table.
+  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  if (options.zoomDials && videos) {
+    // A full turn moves the Zoom picture across the whole output (LAVA: Shift + drag).
+    const render::Size size = (*output)->size();
+    bindings.setDial(static_cast<std::size_t>(options.zoomDials->first),
+                     {runtime::Action::kMoveZoomX, static_cast<double>(size.width)});
+    bindings.setDial(static_cast<std::size_t>(options.zoomDials->second),
+                     {runtime::Action::kMoveZoomY, static_cast<double>(size.height)});
+    videos->followZoomDials(&bindings);
+  }
+  std::unique_ptr<DeviceWiring> devices;
+  if (options.replay) {
+    devices = std::make_unique<DeviceWiring>(clock, [eventLoop] { eventLoop->wake(); });
+    if (auto r = devices->addReplay(*options.replay, !options.replayOnce, matroskaTraceReaderFactory()); !r) {
+      return failWith(r.error(), "cannot replay");
+    }
+    frameLoop.addParticipant(devices->participant());
+    frameLoop.setEvents(&devices->events(), &bindings);
+    devices->start(manual);
+  }
+
+  // [lock]: the frame lock is the last participant, so that the leader sends the frame's final
+  // state and a follower's state from the leader is what is drawn.
+  std::unique_ptr<FrameLock> lock;
+  std::optional<NetClockProbe> clockProbe;
+  if (lockSpec.role != LockRole::kOff) {
+    LockSpec spec = lockSpec;
+    if (spec.node.empty()) spec.node = hostName();
+    auto made = FrameLock::create(spec, clock, show);
+    if (!made) return failWith(made.error(), "cannot lock frames with the other nodes");
+    lock = std::move(*made);
+    if (netClock) {
+      clockProbe.emplace(*netClock);
+      lock->setClockProbe(&*clockProbe);
+      lock->setSharedClock(*netClock);
+    }
+    lock->setDirector(&director);
+    // Movies on the group's timeline. A follower waits (bounded) for the movie frame the leader
+    // draws; the leader waits briefly too, so that a decoder a little late does not part its
+    // picture from the followers'.
+    const std::chrono::milliseconds patience(lock->leader() ? std::min(spec.timeoutMs, 50)
+                                                            : std::min(spec.leaderTimeoutMs, 500));
+    director.setLocked(lock->leader(), patience);
+    // The script's VCR and the --movie streams, which no director plays, are shown by the
+    // leader's frame number too (leaders keep their own timeline).
+    if (player) {
+      lock->addMovies(*player);
+      if (!lock->leader()) player->followLeader(patience);
+    }
+    if (videos) {
+      lock->addMovies(*videos);
+      if (!lock->leader()) videos->followLeader(patience);
+    }
+    lock->setPublisher([&board, &director, supervision = supervisor.get(), holding = false,
+                        leaderAt = spec.leader](const FrameLockFigures& figures) mutable {
+      FrameLockFigures f = figures;
+      f.watchdogPingsHolding = supervision->pingsWhileHolding();
+      board.publishLock(f);
+      // What `systemctl status` shows: a follower holding for a lost leader says so (its loop
+      // keeps pinging the watchdog meanwhile), and says what plays again once the leader is back.
+      if (f.holding) {
+        holding = true;
+        supervision->status(fmt::format("holding frame {}: the frame-lock leader at {} is lost; waiting for it",
+                                        f.heldFrame, leaderAt));
+      } else if (holding) {
+        holding = false;
+        if (const KioskPolicy* policy = director.policy()) supervision->status(policy->describe());
+      }
+    });
+    frameLoop.addParticipant(*lock);
+    if (lock->leader()) {
+      const std::int64_t joined = lock->awaitFollowers(**loop);
+      fmt::print("basalt: frame lock: leader '{}', {} of {} followers joined\n", spec.node, joined, spec.followers);
+    } else {
+      frameLoop.setGate(lock.get());
+      fmt::print("basalt: frame lock: follower '{}' of the leader at {}\n", spec.node, spec.leader);
+    }
+    std::fflush(stdout);
+  }
+
+  Image snapshot;
+  bool snapshotWritten = false;
+  frameLoop.setFrameHook([&](std::int64_t, bool last, render::Output& out) -> Result<void> {
+    if (!last || out.kind() != "headless") return {};
+    if (auto r = out.readBack(snapshot); !r) return r;
+    if (auto r = media::writeImage(snapshotPath, snapshot); !r) return r;
+    snapshotWritten = true;
+    return {};
+  });
+
+  auto stats = frameLoop.run();
+  if (lock && lock->leader() && stats) lock->sayBye(stats->frames - 1);
+  std::vector<devices::DeviceStatus> deviceStatus;
+  if (devices) {
+    deviceStatus = devices->manager().status();
+    devices->stop();
+  }
+  supervisor->stopping();
+  server.reset();
+  if (!stats) return failWith(stats.error(), "the show stopped");
+
+  if (options.saveModel) {
+    const script::ObjectSource object = player ? player->interpreter().objectSource() : script::ObjectSource{};
+    if (auto r = writeSavedModel(*options.saveModel, script::saveModel(show, object)); !r) {
+      return failWith(r.error(), "cannot save the model");
+    }
+  }
+
+  const double rate = stats->wallSeconds > 0 ? static_cast<double>(stats->frames) / stats->wallSeconds : 0;
+  const std::string what = options.manifest ? fmt::format("'{}'", manifest.name)
+                           : options.show   ? options.show->string()
+                                            : std::string("the default show");
+  fmt::print("basalt: played {}: {} frames in {:.2f} s ({:.1f} frames per second, {} clock)\n", what, stats->frames,
+             stats->wallSeconds, rate, manual ? "manual" : "system");
+  fmt::print("basalt: output: {}\n", (*output)->describe());
+  fmt::print("basalt: first frame after {:.1f} ms\n", stats->firstFrameSeconds * 1000);
+  if (player) printScriptSummary(*player);
+  if (director.reloadsApplied() + director.reloadsFailed() > 0) {
+    const FrameFigures f = board.frameFigures();
+    fmt::print(
+        "basalt: reloads: {} applied, {} failed; frames missed at a reload: {} (longest frame at a reload "
+        "{:.1f} ms, median frame {:.1f} ms)\n",
+        director.reloadsApplied(), director.reloadsFailed(), f.missedAtReload, f.longestAtReload * 1e3,
+        f.intervalP50 * 1e3);
+  }
+  if (const KioskPolicy* policy = director.policy(); policy && options.manifest) {
+    fmt::print("basalt: at the end: {}\n", policy->describe());
+  }
+  if (lock) fmt::print("basalt: {}\n", lock->describe());
+  if (snapshotWritten) fmt::print("basalt: snapshot written to {}\n", snapshotPath.string());
+  if (options.saveModel) fmt::print("basalt: model saved to {}\n", options.saveModel->string());
+  if (videos) {
+    for (const std::string& line : videos->status()) fmt::print("basalt: {}\n", line);
+  }
+  int status = 0;
+  if (recorder) {
+    if (auto r = recorder->finish(); !r) {
+      std::fflush(stdout);
+      status = failWith(r.error(), "the recording failed (the show itself ran)");
+    } else {
+      fmt::print("basalt: recorded {} frames to {} ({})\n", recorder->frames(), recorder->options().path.string(),
+                 recorder->describe());
+    }
+  }
+  if (devices) {
+    for (const devices::DeviceStatus& s : deviceStatus) {
+      fmt::print("basalt: replayed {} '{}' ({})\n", devices::deviceKindName(s.kind), s.name,
+                 s.lastError.empty() ? std::string(devices::deviceStateName(s.state)) : s.lastError);
+    }
+  }
+  std::fflush(stdout);
+  return status;
+}
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,97 @@
+#pragma once
+
+/// \file
+/// \brief The views a show manifest asks for (`[[views]]`), drawn each frame: plain views, one
+/// stereo eye per view (a passive projector per eye), facets of a polyhedral display (thesis
+/// §4.4) in mono or any stereo layout, tiled in one output or each filling an output, and the
+/// visual aids of a facet view (§4.4.6: the display seen from outside with the current facet,
+/// its normal, the viewer and the computed vectors, over the world).
+/// Holds each facet view's calibration, adjustable live with the thesis' keys (Appendix B) and
+/// saved back to its `.cave` file.
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "kiosk/manifest/manifest.h"
+#include "render/facet_view.h"
+#include "render/renderer.h"
+#include "runtime/cave_aids.h"
+#include "runtime/cave_keys.h"
+#include "runtime/formats/cave.h"
+
+namespace basalt::kiosk {
+
+/// \brief Draws the frame instead of the single plain view (FrameLoop::setViewDrawer).
+class ViewDrawer {
+ public:
+  virtual ~ViewDrawer() = default;
+  virtual void drawViews(const runtime::Show& show, render::Size output,
+                         const std::function<void(runtime::ViewTransforms&)>& adjust) = 0;
+};
+
+/// \brief A manifest's views, ready to draw.
+///
+/// Threading: the frame loop's thread (it draws with GL).
+class DisplayViews final : public ViewDrawer {
+ public:
+  /// \brief Loads each facet view's cave file and checks its facet; views without a viewport
+  /// are tiled over the output (a grid, left to right, top to bottom). Needs the GL context.
+  [[nodiscard]] static Result<std::unique_ptr<DisplayViews>> create(const std::vector<ViewSpec>& views,
+                                                                    render::Renderer& renderer, render::Size output);
+
+  void drawViews(const runtime::Show& show, render::Size output,
+                 const std::function<void(runtime::ViewTransforms&)>& adjust) override;
+
+  /// \brief A keyboard event for the calibration keys; they act on the current facet view
+  /// (the first, or the one chosen with selectView). True when something changed.
+  bool applyKey(const Event& event);
+  /// \brief The view the calibration keys act on; false when `index` is not a facet view.
+  bool selectView(std::size_t index);
+  /// \brief The calibration of view `index` (a facet view), to read or change live.
+  [[nodiscard]] formats::CaveSettings* calibration(std::size_t index);
+  /// \brief Calibration as text, for the control server: `statements` in the cave file's syntax
+  /// (`facet`, `side`, `Xscale`, `Yscale`, `Xskew`, `Yskew`, `Zrotation`; no `model`), one per
+  /// line or separated by ';', applied to the facet view named `name` ("" = the first) as one
+  /// change: a bad statement changes nothing. With `save`, written back to its cave file.
+  /// Returns the view's settings afterwards, in the cave file's bracket form on one line. Errors: kNotFound (no such
+  /// facet view), kInvalidArgument or kParse (a bad statement), kIo (the file could not be written).
+  [[nodiscard]] Result<std::string> calibrate(std::string_view name, std::string_view statements, bool save);
+  /// \brief Writes view `index`'s calibration back to its cave file.
+  [[nodiscard]] Result<void> saveCalibration(std::size_t index) const;
+  /// \brief The projection drawn last for view `index` (facet views).
+  [[nodiscard]] const runtime::FacetProjection* lastProjection(std::size_t index) const;
+  /// \brief The visual aids drawn last by view `index` (aids views).
+  [[nodiscard]] const runtime::CaveAids* aids(std::size_t index) const;
+  [[nodiscard]] std::size_t size() const { return views_.size(); }
+
+ private:
+  struct View {
+    ViewSpec spec;
+    render::Viewport viewport;  ///< GL coordinates (from the bottom left)
+    formats::LoadedCave cave;   ///< facet views
+    runtime::FacetProjection last;
+    float eyeSpacing = -1;  ///< facet views: < 0 follows the show
+    bool warned = false;
+    std::size_t shows = 0;                  ///< aids views: the facet view whose set-up they show
+    std::optional<runtime::CaveAids> aids;  ///< aids views
+  };
+  /// The facet view `of` names (the first facet view when empty), if any.
+  [[nodiscard]] std::optional<std::size_t> facetViewNamed(const std::string& of) const;
+  /// The facet input of facet view `v` this frame (no aspect: the caller sets it).
+  static runtime::FacetViewInput facetInput(const View& v, const runtime::Show& show);
+  void drawAids(View& v, const runtime::Show& show, const std::function<void(runtime::ViewTransforms&)>& adjust);
+  DisplayViews(render::Renderer& renderer, std::unique_ptr<render::FacetRenderer> facets)
+      : renderer_(renderer), facets_(std::move(facets)) {}
+
+  render::Renderer& renderer_;
+  std::unique_ptr<render::FacetRenderer> facets_;
+  std::vector<View> views_;
+  std::size_t current_ = 0;
+  runtime::CaveKeys keys_;
+};
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,25 @@
+#pragma once
+
+/// \file
+/// \brief `basalt check` for the content formats of runtime/formats: scenes (.sce), models
+/// (.obj, .off) and cave files (.cave), as whole files and as files a manifest names.
+
+#include <filesystem>
+#include <vector>
+
+#include "kiosk/manifest/content_check.h"
+#include "kiosk/manifest/manifest.h"
+
+namespace basalt::kiosk {
+
+/// \brief `basalt check FILE`: prints each problem as `file:line: error|warning: ...`.
+CheckResult checkSceneFile(const std::filesystem::path& file);
+CheckResult checkModelFile(const std::filesystem::path& file);
+CheckResult checkCaveFile(const std::filesystem::path& file);
+
+/// \brief The same checks for files a manifest names, as manifest diagnostics.
+std::vector<Diagnostic> checkSceneContent(const std::filesystem::path& file);
+std::vector<Diagnostic> checkModelContent(const std::filesystem::path& file);
+std::vector<Diagnostic> checkCaveContent(const std::filesystem::path& file);
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,102 @@
+#include "kiosk/show/device_wiring.h"
+
+#include <fmt/format.h>
+
+#include "devices/hid/hid_backend.h"
+#include "devices/libcamera/libcamera_camera.h"
+#include "devices/serial/sgi_dial_box.h"
+#include "devices/v4l2/v4l2_camera.h"
+#include "runtime/log.h"
+#include "sim/providers.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Wiring, "kiosk");
+
+Result<devices::DeviceRequest> parseDeviceSpec(std::string_view text, devices::DeviceKind kind, std::string name) {
+  devices::DeviceRequest r;
+  r.name = std::move(name);
+  r.kind = kind;
+  const auto colon = text.find(':');
+  r.match.backend = std::string(text.substr(0, colon));
+  static constexpr std::string_view kBackends[] = {"hid", "serial", "v4l2", "libcamera", "synthetic", "replay"};
+  if (std::find(std::begin(kBackends), std::end(kBackends), r.match.backend) == std::end(kBackends)) {
+    return fail(Errc::kInvalidArgument,
+                fmt::format("'{}' does not start with a backend: hid, serial, v4l2, libcamera, synthetic or replay "
+                            "(e.g. hid:077d:0410, v4l2:/dev/video0)",
+                            text));
+  }
+  if (colon == std::string_view::npos) return r;
+  const std::string_view rest = text.substr(colon + 1);
+  if (rest.size() == 9 && rest[4] == ':' && parseVendorProduct(rest, r.match)) return r;
+  if (rest.starts_with("/") || rest.starts_with("usb:") || r.match.backend == "libcamera" ||
+      r.match.backend == "synthetic") {
+    r.match.path = std::string(rest);
+  } else {
+    r.match.name = std::string(rest);
+  }
+  return r;
+}
+
+std::vector<std::unique_ptr<devices::DeviceProvider>> allProviders(const std::vector<std::string>& serialPorts) {
+  std::vector<std::unique_ptr<devices::DeviceProvider>> out;
+  out.push_back(std::make_unique<devices::HidProvider>());
+  out.push_back(std::make_unique<devices::SerialProvider>(serialPorts));
+  out.push_back(std::make_unique<devices::V4l2Provider>());
+  out.push_back(std::make_unique<devices::LibcameraProvider>());
+  out.push_back(std::make_unique<sim::SyntheticProvider>());
+  return out;
+}
+
+DeviceWiring::DeviceWiring(const Clock& clock, std::function<void()> wake)
+    : clock_(clock), events_(4096, std::move(wake)), manager_(clock, events_) {}
+
+DeviceWiring::~DeviceWiring() { stop(); }
+
+Result<void> DeviceWiring::addReplay(const std::filesystem::path& path, bool loop,
+                                     sim::TraceVideoReaderFactory videoReader) {
+  auto provider = std::make_unique<sim::ReplayProvider>(std::move(videoReader));
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    if (auto r = provider->addTrace(path); !r) return r;
+  } else if (auto r = provider->addHidRecording(path); !r) {
+    return r;
+  }
+  auto requests = provider->requests();
+  manager_.addProvider(std::move(provider));
+  for (auto& r : requests) {
+    r.options["loop"] = loop ? "true" : "false";
+    if (auto id = manager_.request(r); !id) return std::unexpected(id.error());
+  }
+  return {};
+}
+
+void DeviceWiring::start(bool manualClock) {
+  manual_ = manualClock;
+  started_ = true;
+  if (manual_) {
+    manager_.step(clock_.now());  // open what is there before the first frame
+    return;
+  }
+  if (auto monitor = devices::UdevMonitor::create()) {
+    udev_ = std::move(*monitor);
+    udev_->start([this](devices::HotplugEvent e) { manager_.notifyHotplug(std::move(e)); });
+  } else {
+    log::debug(kLogWiring, "{}", monitor.error().describe());
+  }
+  manager_.start();
+}
+
+void DeviceWiring::stop() {
+  if (!started_) return;
+  started_ = false;
+  if (udev_) udev_->stop();
+  manager_.stop();
+}
+
+Result<void> DeviceWiring::Stepper::beforeDraw(const FrameContext& frame) {
+  if (wiring_.manual_) wiring_.manager_.step(frame.time);
+  return {};
+}
+
+}  // namespace basalt::kiosk

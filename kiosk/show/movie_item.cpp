@@ -1,0 +1,220 @@
+// Movies as show items: a media::MoviePlayer decoding on its own thread, its frames converted
+// on the GPU by a render::StreamTexture, drawn full screen by a render::PictureOverlay after the
+// (empty, black) show is drawn. Under a ManualClock each frame waits for the frame due, so that
+// offline runs and tests are exact; on the system clock the frame loop never waits.
+
+#include "kiosk/show/movie_item.h"
+
+#include <algorithm>
+#include <chrono>
+#include <optional>
+
+#include <fmt/format.h>
+#include <fmt/std.h>
+
+#include "media/movie_player.h"
+#include "runtime/log.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(MovieItems, "items");
+
+namespace {
+
+/// How long the loader waits for a movie's first frame before calling it unplayable.
+constexpr std::chrono::seconds kLoadTimeout{10};
+/// How long a frame under a ManualClock waits for the decoder.
+constexpr std::chrono::seconds kFrameTimeout{10};
+
+/// The error, located at the manifest line that names the movie (the file it concerns, if any,
+/// kept in the message).
+Error atEntry(const Error& e, const std::string& where) {
+  if (e.where().empty()) return e.at(where);
+  return {e.code(), fmt::format("{}: {}", e.where(), e.message()), where};
+}
+
+class MovieItem final : public ItemPlayer {
+ public:
+  MovieItem(EntrySpec entry, std::string where, std::unique_ptr<media::MoviePlayer> player)
+      : entry_(std::move(entry)), where_(std::move(where)), player_(std::move(player)) {}
+
+  void setPlayback(const Playback& playback) override { playback_ = playback; }
+
+  Result<void> start(runtime::Show& show, Nanos position, double /*fps*/) override {
+    show = runtime::Show();  // black around the picture
+    if (!texture_) {
+      auto texture = render::StreamTexture::create(fmt::format("movie item {}", entry_.text));
+      if (!texture) return std::unexpected(atEntry(texture.error(), where_));
+      texture_ = std::move(*texture);
+      texture_->setFallbackColor(0, 0, 0);
+      auto overlay = render::PictureOverlay::create();
+      if (!overlay) return std::unexpected(atEntry(overlay.error(), where_));
+      overlay_ = std::move(*overlay);
+    }
+    if (player_->state() == media::MovieState::kEmpty) {
+      // Unloaded after a failure: try the file again (it may have been replaced).
+      if (auto r = player_->load(entry_.path); !r) return std::unexpected(atEntry(r.error(), where_));
+    }
+    if (player_->state() == media::MovieState::kFailed) return std::unexpected(failure());
+    player_->setRepeat(playback_.loop);
+    if (playback_.timelineStart && placeOnTimeline(position)) {
+      // Nothing from an earlier turn, and never the clip's first frame: the screen stays black
+      // until the frame due on the group's timeline is there.
+      texture_->showFallback();
+    } else {
+      const Nanos duration = player_->info().duration;
+      if (duration > Nanos{0} && position >= duration) position = playback_.loop ? position % duration : Nanos{0};
+      if (started_ || position > Nanos{0}) player_->seekTime(position);
+    }
+    player_->play();
+    started_ = true;
+    ended_ = false;
+    endsAt_.reset();
+    return {};
+  }
+
+  Result<void> beforeDraw(const FrameContext& frame, runtime::Show& /*show*/) override {
+    leaderResult_ = LeaderFrameResult::kNone;
+    if (endsAt_) {
+      // The last frame stays up for its own duration, then the item ends.
+      if (frame.time >= *endsAt_) ended_ = true;
+      return {};
+    }
+    // Offline runs wait for the frame due; so does a frame-locked node on the system clock,
+    // bounded, so that it draws the frame the others draw.
+    const std::chrono::milliseconds patience =
+        playback_.manualClock     ? std::chrono::duration_cast<std::chrono::milliseconds>(kFrameTimeout)
+        : playback_.timelineStart ? playback_.patience
+                                  : std::chrono::milliseconds(0);
+    FrameRef f;
+    if (playback_.timelineStart && leaderFrame_ >= 0) {
+      // A follower shows the leader's frame by its number, not by its own decoder's timestamps
+      // (which can add up a fraction of a millisecond apart from the leader's).
+      media::NumberedFrame pick = player_->frameNumbered(leaderFrame_, frame.time, patience);
+      f = std::move(pick.frame);
+      leaderResult_ = leaderFrameResultOf(pick.outcome);
+    } else {
+      if (patience.count() > 0) player_->waitForFrameDue(frame.time, patience);
+      f = player_->frameAt(frame.time);
+      if (f && playback_.timelineStart && patience.count() > 0) {
+        // The frame a seek onto the timeline brought was due when the item started; a node that
+        // waited for it takes the frame due now as well, as the others do in this frame.
+        player_->waitForFrameDue(frame.time, patience);
+        if (FrameRef newer = player_->frameAt(frame.time)) f = std::move(newer);
+      }
+    }
+    const media::MovieState state = player_->state();
+    if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) return std::unexpected(failure());
+    auto changed = texture_->update(f);
+    if (!changed) {
+      player_->unload();
+      return std::unexpected(atEntry(changed.error(), where_));
+    }
+    if (!playback_.loop && player_->atEnd()) {
+      const Nanos frameDuration = player_->info().frameDuration;
+      endsAt_ = frame.time + std::max(frameDuration, Nanos{1});
+    }
+    return {};
+  }
+
+  Result<void> afterDraw(const FrameContext& /*frame*/, render::Output& output) override {
+    if (!texture_ || texture_->showingFallback()) return {};  // no frame yet: black, never a grey flash
+    const render::TextureView& view = texture_->view();
+    const double aspect = player_->info().pixelAspect > 0 ? player_->info().pixelAspect : 1.0;
+    const render::Size size = output.size();
+    overlay_->draw(view, letterbox(view.size.width * aspect, view.size.height, size), size);
+    return {};
+  }
+
+  [[nodiscard]] bool ended() const override { return ended_; }
+
+  [[nodiscard]] std::int64_t shownFrame() const override {
+    return texture_ && !texture_->showingFallback() ? player_->currentFrame() : -1;
+  }
+
+  void setLeaderFrame(std::int64_t frame) override { leaderFrame_ = frame; }
+  [[nodiscard]] LeaderFrameResult leaderFrameResult() const override { return leaderResult_; }
+
+ private:
+  /// Frame-locked: seeks to the frame due `position` after the item's start on the group's
+  /// timeline, due at the show time it belongs to (not when the seek lands), so that every
+  /// later frame and loop falls where it falls on the other nodes. A loop's pass is the
+  /// player's own once it has looped, else the clip's frames x their duration. False when the
+  /// clip's frame rate is unknown (then it plays from its own start).
+  bool placeOnTimeline(Nanos position) {
+    const Nanos frame = player_->info().frameDuration;
+    if (frame <= Nanos{0}) return false;
+    const Nanos elapsed = std::max(Nanos{0}, position);
+    const std::int64_t count = player_->frameCount();
+    Nanos passStart{0};
+    if (playback_.loop) {
+      const Nanos pass = player_->passDuration() > Nanos{0} ? player_->passDuration()
+                         : count > 0                        ? frame * count
+                                                            : Nanos{0};
+      if (pass > Nanos{0}) passStart = (elapsed / pass) * pass;
+    }
+    // As for a movie stream (kiosk/show/stream_factories.cpp): timestamps sit up to half a
+    // millisecond off the frame grid, so take the frame before when in doubt; the next update
+    // takes the next one if it is due.
+    std::int64_t index = std::max<std::int64_t>(0, (elapsed - passStart + std::chrono::microseconds(1000)) / frame);
+    if (count > 0) index = std::min(index, count - 1);
+    const Nanos timeline = passStart + frame * index;
+    player_->seekFrameDueAt(index, *playback_.timelineStart + timeline, timeline);
+    log::debug(kLogMovieItems, "{}: movie {} joins the group's timeline {:.3f} s into the item: frame {}", where_,
+               entry_.text, toSeconds(position), index);
+    return true;
+  }
+
+  [[nodiscard]] Error failure() const {
+    const auto error = player_->error();
+    return atEntry(error ? *error : Error(Errc::kIo, "the movie stopped", entry_.path.string()), where_);
+  }
+
+  EntrySpec entry_;
+  std::string where_;
+  std::unique_ptr<media::MoviePlayer> player_;
+  std::unique_ptr<render::StreamTexture> texture_;  // made at the first start (needs the GL context)
+  std::unique_ptr<render::PictureOverlay> overlay_;
+  Playback playback_;
+  bool started_ = false;
+  bool ended_ = false;
+  std::optional<Nanos> endsAt_;    // show time the shown last frame ends at (not looping)
+  std::int64_t leaderFrame_ = -1;  // frame-locked follower: the leader's movie frame in the coming frame
+  LeaderFrameResult leaderResult_ = LeaderFrameResult::kNone;
+};
+
+}  // namespace
+
+LeaderFrameResult leaderFrameResultOf(media::NumberedOutcome outcome) {
+  switch (outcome) {
+    case media::NumberedOutcome::kAgreed: return LeaderFrameResult::kAgreed;
+    case media::NumberedOutcome::kCorrected: return LeaderFrameResult::kCorrected;
+    case media::NumberedOutcome::kLate: return LeaderFrameResult::kLate;
+  }
+  return LeaderFrameResult::kNone;
+}
+
+render::PictureRect letterbox(double pictureWidth, double pictureHeight, render::Size output) {
+  if (!(pictureWidth > 0) || !(pictureHeight > 0) || output.width == 0 || output.height == 0) return {};
+  const double scale = std::min(output.width / pictureWidth, output.height / pictureHeight);
+  const double w = pictureWidth * scale;
+  const double h = pictureHeight * scale;
+  return {static_cast<float>((output.width - w) / 2), static_cast<float>((output.height - h) / 2),
+          static_cast<float>(w), static_cast<float>(h)};
+}
+
+Result<std::unique_ptr<ItemPlayer>> makeMovieItem(const EntrySpec& entry, const Manifest& show) {
+  const std::string where = fmt::format("{}:{}", show.file.string(), entry.line);
+  media::MoviePlayerOptions options;
+  options.name = fmt::format("movie item {}", entry.text);
+  auto player = media::MoviePlayer::create(options);
+  if (!player) return std::unexpected(atEntry(player.error(), where));
+  if (auto r = (*player)->load(entry.path); !r) return std::unexpected(atEntry(r.error(), where));
+  auto info = (*player)->waitUntilLoaded(kLoadTimeout);
+  if (!info) return std::unexpected(atEntry(info.error(), where));
+  log::info(kLogMovieItems, "{}: movie {}: {}x{} at {:.3g} fps, {}", where, entry.text, info->width, info->height,
+            info->fps, info->codec.empty() ? std::string("codec unknown") : info->codec);
+  return std::make_unique<MovieItem>(entry, where, std::move(*player));
+}
+
+}  // namespace basalt::kiosk

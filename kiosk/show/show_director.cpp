@@ -1,0 +1,985 @@
+#include "kiosk/show/show_director.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <fmt/std.h>
+
+#include "kiosk/loop/display_views.h"
+#include "runtime/log.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Director, "kiosk");
+
+namespace {
+
+constexpr Nanos kSaveEvery = std::chrono::seconds(2);
+constexpr Nanos kMaxRetry = std::chrono::seconds(30);
+
+}  // namespace
+
+/// A dial box's open on the device thread; `result` is written before `done`.
+struct PendingOpen {
+  std::atomic<bool> done{false};
+  Result<void> result;
+};
+
+/// Opens dial boxes one after another on a thread of its own, so that a device enumeration or a
+/// serial port's reset wait never holds up a frame; it also closes the boxes of a replaced show
+/// whose open was still running. Tasks run in the order given; the thread finishes them all
+/// before it ends.
+class ShowDirector::DeviceThread {
+ public:
+  DeviceThread() : thread_([this] { run(); }) {}
+  ~DeviceThread() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();
+  }
+  DeviceThread(const DeviceThread&) = delete;
+  DeviceThread& operator=(const DeviceThread&) = delete;
+
+  void post(std::function<void()> task) {
+    {
+      std::lock_guard lock(mutex_);
+      tasks_.push_back(std::move(task));
+    }
+    wake_.notify_one();
+  }
+
+ private:
+  void run() {
+    for (;;) {
+      std::function<void()> task;
+      {
+        std::unique_lock lock(mutex_);
+        wake_.wait(lock, [this] { return stopping_ || !tasks_.empty(); });
+        if (tasks_.empty()) return;
+        task = std::move(tasks_.front());
+        tasks_.pop_front();
+      }
+      task();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> tasks_;  // guarded by mutex_
+  bool stopping_ = false;                    // guarded by mutex_
+  std::thread thread_;                       // last: starts once the rest is built
+};
+
+ShowDirector::ShowDirector(DirectorContext context) : context_(context) { context_.board.setShowClock(context_.clock); }
+
+ShowDirector::~ShowDirector() {
+  if (udev_) udev_->stop();
+  deviceThread_.reset();  // an open still running ends first; then every box is the frame loop's
+  if (loader_.joinable()) loader_.join();
+  if (textureLoader_.joinable()) textureLoader_.join();
+  if (show_) {
+    for (DeviceSlot& slot : show_->devices) {
+      if (slot.dialBox) slot.dialBox->close();
+    }
+  }
+  if (policy_ && context_.state) {
+    context_.state->save(policy_->resumePoint(context_.clock.now()));
+    context_.state->flush();
+  }
+}
+
+void ShowDirector::install(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume) {
+  takeOver(std::move(show), now, resume);
+  if (resume && policy_->current().item && policy_->current().item->name == resume->item &&
+      resume->position > Nanos{0}) {
+    log::info(kLogDirector, "resuming '{}' at {:.1f} s, where the show was before it stopped", resume->item,
+              toSeconds(resume->position));
+  }
+}
+
+void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume) {
+  // The old show's devices stop; their queued events are stale.
+  if (show_) {
+    for (DeviceSlot& slot : show_->devices) {
+      if (slot.dialBox && !slot.opening) slot.dialBox->close();  // an opening one: see below
+    }
+    for (const LoadedTexture& t : show_->textures) context_.renderer.textures().remove(t.name);
+  }
+  Event stale;
+  while (context_.events.pop(stale)) {
+  }
+  player_ = nullptr;
+  itemKey_.clear();  // the new show's players are new: what the old item uploaded goes
+  std::unique_ptr<LoadedShow> old = std::move(show_);
+  show_ = std::move(show);
+  reportedFailures_.clear();
+  const WallTime wall = context_.clock.wallNow();
+  for (DeviceSlot& slot : show_->devices) {
+    slot.since = wall;
+    slot.nextAttempt = now;
+  }
+  for (LoadedTexture& t : show_->textures) {
+    if (t.image) {
+      if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
+        log::warn(kLogDirector, "texture '{}': {}", t.name, r.error().describe());
+      }
+    }
+    t.live = false;
+    t.since = wall;
+  }
+  ++showGeneration_;
+  // Images not read yet (start-up) are read once the first frame is on screen, so that decoding
+  // them never delays it.
+  texturesPending_ = true;
+  policy_ = std::make_unique<KioskPolicy>(show_->manifest, show_->schedule);
+  scheduleForStatus_ = show_->schedule ? std::make_shared<const Schedule>(*show_->schedule) : nullptr;
+  policy_->start(now, wall, resume);
+  appliedGeneration_ = 0;
+  // A leader's streams start with its show; a follower keeps the leader's start (it comes with
+  // every frame, and a reload of the leader brings a new one).
+  if (!follower_) mediaStart_ = now;
+  if (locked_) alignStreams();
+  applyProgramme(now);
+  publishDevices();
+  publishStreams();
+  if (old && deviceThread_) {
+    // Boxes whose open still runs belong to the device thread: it closes and drops them after.
+    auto orphans = std::make_shared<std::vector<std::unique_ptr<devices::DialBox>>>();
+    for (DeviceSlot& slot : old->devices) {
+      if (slot.opening && slot.dialBox) orphans->push_back(std::move(slot.dialBox));
+    }
+    if (!orphans->empty()) {
+      deviceThread_->post([orphans] {
+        for (auto& box : *orphans) box->close();
+        orphans->clear();
+      });
+    }
+  }
+  watchHotplug();
+  old.reset();  // after the new show is on: its players and devices go now
+}
+
+void ShowDirector::watchHotplug() {
+  if (udev_ || context_.clock.isManual()) return;
+  const bool hardware = std::ranges::any_of(show_->devices, [](const DeviceSlot& slot) {
+    return slot.dialBox && (slot.spec.backend == DeviceBackend::kHid || slot.spec.backend == DeviceBackend::kSerial);
+  });
+  if (!hardware) return;
+  auto monitor = devices::UdevMonitor::create({"hidraw", "usb", "tty"});
+  if (!monitor) {
+    log::info(kLogDirector, "no udev hotplug ({}): absent dial boxes are tried again on their back-off only",
+              monitor.error().describe());
+    return;
+  }
+  udev_ = std::move(*monitor);
+  udev_->start([this](const devices::HotplugEvent& e) {
+    if (e.action == devices::HotplugEvent::Action::kAdded) noteHotplug();
+  });
+}
+
+void ShowDirector::loadTexturesInBackground() {
+  std::vector<std::pair<std::string, std::filesystem::path>> wanted;
+  for (const LoadedTexture& t : show_->textures) {
+    if (!t.image && !t.imageFile.empty()) wanted.emplace_back(t.name, t.imageFile);
+  }
+  if (wanted.empty()) return;
+  if (textureLoader_.joinable()) textureLoader_.join();
+  textureLoader_ = std::thread([this, wanted = std::move(wanted), generation = showGeneration_] {
+    std::vector<std::pair<std::string, std::optional<Image>>> images;
+    for (const auto& [name, file] : wanted) images.emplace_back(name, readTextureImage(name, file));
+    {
+      std::lock_guard lock(reloadMutex_);
+      textures_ = std::move(images);
+      texturesFor_ = generation;
+      texturesReady_ = true;
+    }
+    context_.loop.wake();
+  });
+}
+
+void ShowDirector::pollTextures() {
+  std::vector<std::pair<std::string, std::optional<Image>>> images;
+  {
+    std::lock_guard lock(reloadMutex_);
+    if (!texturesReady_) return;
+    texturesReady_ = false;
+    if (texturesFor_ != showGeneration_) return;  // read for a show that has been replaced since
+    images = std::move(textures_);
+  }
+  for (auto& [name, image] : images) {
+    if (!image) continue;
+    for (LoadedTexture& t : show_->textures) {
+      if (t.name != name) continue;
+      t.image = std::move(*image);
+      if (!t.live) {
+        if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
+          log::warn(kLogDirector, "texture '{}': {}", t.name, r.error().describe());
+        }
+      }
+    }
+  }
+}
+
+void ShowDirector::requestReload() {
+  if (!show_ || show_->manifest.file.empty()) {
+    log::info(kLogDirector, "reload asked, but the built-in default show has no manifest to re-read");
+    return;
+  }
+  if (loading_) {
+    log::info(kLogDirector, "reload asked while one is under way; the newer manifest is read when it ends");
+    return;
+  }
+  if (loader_.joinable()) loader_.join();
+  loading_ = true;
+  if (context_.supervisor) context_.supervisor->reloading();
+  log::info(kLogDirector, "reloading {}; the current show plays on until the new one is ready", show_->manifest.file);
+  const std::filesystem::path file = show_->manifest.file;
+  loader_ = std::thread([this, file] {
+    Diagnostics diagnostics;
+    auto loaded = readAndLoadShow(file, context_.clock, diagnostics);
+    {
+      std::lock_guard lock(reloadMutex_);
+      reloadReady_ = true;
+      if (loaded) {
+        reloaded_ = std::move(*loaded);
+        for (const Diagnostic& d : diagnostics.items()) {
+          if (d.severity == Severity::kWarning) log::warn(kLogDirector, "{}", d.format());
+        }
+      } else {
+        reloadError_ = loaded.error().describe();
+        for (const Diagnostic& d : diagnostics.items()) {
+          if (d.severity == Severity::kError) log::error(kLogDirector, "{}", d.format());
+        }
+      }
+    }
+    context_.loop.wake();
+  });
+}
+
+void ShowDirector::pollReload(const FrameContext& frame) {
+  if (!loading_) return;
+  std::unique_ptr<LoadedShow> next;
+  std::string error;
+  {
+    std::lock_guard lock(reloadMutex_);
+    if (!reloadReady_) return;
+    reloadReady_ = false;
+    next = std::move(reloaded_);
+    error = std::move(reloadError_);
+  }
+  loading_ = false;
+  loader_.join();
+  const Nanos now = frame.time;
+  if (!next) {
+    ++reloadsFailed_;
+    log::error(kLogDirector, "reload failed: {}; the current show plays on", error);
+    context_.board.noteReload(false, "failed: " + error);
+    if (context_.supervisor) context_.supervisor->reloaded("reload failed: " + error + "; " + policy_->describe());
+    return;
+  }
+  const auto resume = policy_ ? std::optional<ResumePoint>(policy_->resumePoint(now)) : std::nullopt;
+  takeOver(std::move(next), now, resume);
+  ++reloadsApplied_;
+  commands_.restart(static_cast<std::uint32_t>(reloadsApplied_));  // the log starts with the show
+  lastReloadFrame_ = frame.frame;
+  context_.board.noteReloadApplied(frame.frame);
+  context_.board.noteReload(true, fmt::format("reloaded at frame {}", frame.frame));
+  log::info(kLogDirector, "reloaded {}: {}", show_->manifest.file, policy_->describe());
+  if (context_.supervisor) context_.supervisor->reloaded(policy_->describe());
+}
+
+void ShowDirector::handleControls(const FrameContext& frame) {
+  const Nanos now = frame.time;
+  const bool lockLeader = locked_ && !follower_;
+  bool commandRun = false;
+  ControlRequest request;
+  for (;;) {
+    if (deferredCommand_) {
+      request = std::move(*deferredCommand_);
+      deferredCommand_.reset();
+    } else if (!context_.board.controls().pop(request)) {
+      break;
+    }
+    if (request.kind == ControlKind::kRunCommand && lockLeader && commandRun) {
+      // A frame carries one command to the followers: the next one waits for the next frame,
+      // and so do the requests after it, which keep their order.
+      deferredCommand_ = std::move(request);
+      break;
+    }
+    auto& reply = *request.reply;
+    switch (request.kind) {
+      case ControlKind::kNext:
+      case ControlKind::kPrevious: {
+        if (follower_) {
+          // One director for the group: the leader's. Moving one node would part it from the others.
+          reply.answer(409,
+                       "this node follows its frame-lock leader, which decides what plays: send the request "
+                       "to the leader's control server");
+          break;
+        }
+        const bool moved = request.kind == ControlKind::kNext ? policy_->next(now) : policy_->previous(now);
+        if (moved) {
+          applyProgramme(now);
+          reply.answer(200, policy_->describe());
+        } else {
+          reply.answer(409, "nothing to move to: " + policy_->describe());
+        }
+        break;
+      }
+      case ControlKind::kReload:
+        if (!show_ || show_->manifest.file.empty()) {
+          reply.answer(409, "the built-in default show has no manifest to reload");
+        } else {
+          requestReload();
+          reply.answer(202, "reloading " + show_->manifest.file.string());
+        }
+        break;
+      case ControlKind::kRunCommand:
+        commandRun = lockLeader;
+        runCommand(frame, request);
+        break;
+      case ControlKind::kRestartDevice: {
+        auto it = std::find_if(show_->devices.begin(), show_->devices.end(),
+                               [&](const DeviceSlot& s) { return s.spec.name == request.argument; });
+        if (it == show_->devices.end()) {
+          reply.answer(404, fmt::format("no device '{}' in this show", request.argument));
+        } else if (!it->dialBox) {
+          reply.answer(409, fmt::format("'{}' cannot be restarted: {}", request.argument, it->unavailable));
+        } else {
+          it->dialBox->close();
+          const auto id = static_cast<DeviceId>(it - show_->devices.begin() + 1);
+          auto opened = it->dialBox->open(id, context_.events);
+          it->backoff = std::chrono::seconds(1);
+          it->nextAttempt = now + it->backoff;
+          it->message = opened ? std::string() : opened.error().message();
+          log::info(kLogDirector, "device '{}' restarted by the control server: {}", request.argument,
+                    opened ? "live" : it->message);
+          // A device that is not there is not the server's fault: 503, and the director retries.
+          reply.answer(opened ? 200 : 503,
+                       opened ? fmt::format("'{}' restarted", request.argument)
+                              : fmt::format("'{}' could not be reopened: {}; it is retried every few seconds",
+                                            request.argument, opened.error().describe()));
+        }
+        break;
+      }
+      case ControlKind::kCalibrate: {
+        if (!views_) {
+          reply.answer(409, "this show has no facet views to calibrate (add [[views]] with kind = \"facet\")");
+          break;
+        }
+        auto out = views_->calibrate(request.view, request.argument, request.save);
+        if (out) {
+          reply.answer(200, *out);
+        } else {
+          const Errc code = out.error().code();
+          reply.answer(code == Errc::kNotFound ? 404 : code == Errc::kIo ? 500 : 400, out.error().describe());
+        }
+        break;
+      }
+    }
+  }
+}
+
+void ShowDirector::serviceDevices(Nanos now) {
+  bool changed = false;
+  const WallTime wall = context_.clock.wallNow();
+  if (hotplug_.exchange(false, std::memory_order_acq_rel)) {
+    // Something was plugged in: whatever is absent may be it.
+    for (DeviceSlot& slot : show_->devices) {
+      if (slot.dialBox && !slot.opening && slot.dialBox->state() != devices::DeviceState::kLive) {
+        slot.nextAttempt = now;
+        slot.backoff = std::chrono::seconds(1);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < show_->devices.size(); ++i) {
+    DeviceSlot& slot = show_->devices[i];
+    if (!slot.dialBox) continue;
+    devices::DialBox& box = *slot.dialBox;
+    if (slot.opening) {
+      // The device thread owns the box until its open is done.
+      if (!slot.opening->done.load(std::memory_order_acquire)) continue;
+      const Result<void> opened = std::move(slot.opening->result);
+      slot.opening.reset();
+      noteOpen(slot, opened, now, changed);
+    } else if (box.state() != devices::DeviceState::kLive && now >= slot.nextAttempt) {
+      const auto id = static_cast<DeviceId>(i + 1);
+      if (context_.clock.isManual()) {
+        // Under a ManualClock a run repeats frame by frame: the open happens here.
+        const Result<void> opened = box.open(id, context_.events);
+        noteOpen(slot, opened, now, changed);
+      } else {
+        // Enumerating devices and opening one can take long (a serial port's reset wait):
+        // never on the frame loop's thread.
+        if (!deviceThread_) deviceThread_ = std::make_unique<DeviceThread>();
+        auto pending = std::make_shared<PendingOpen>();
+        slot.opening = pending;
+        BoundedQueue<Event>* events = &context_.events;
+        devices::DialBox* target = &box;
+        deviceThread_->post([target, id, events, pending] {
+          pending->result = target->open(id, *events);
+          pending->done.store(true, std::memory_order_release);
+        });
+        continue;
+      }
+    }
+    box.service(now);
+    if (box.state() != slot.state) {
+      if (slot.state == devices::DeviceState::kLive) {
+        // Its bindings let go: a shuttle held when the cable was pulled stops turning.
+        slot.dials.apply(Event{now, static_cast<DeviceId>(i + 1), EventKind::kDeviceState, 0, 0.0}, context_.show);
+        log::warn(kLogDirector, "device '{}' is {}; its bindings are quiet until it comes back", slot.spec.name,
+                  devices::deviceStateName(box.state()));
+        slot.nextAttempt = now + slot.backoff;
+      } else if (box.state() == devices::DeviceState::kLive) {
+        log::info(kLogDirector, "device '{}' is live ({})", slot.spec.name, box.info().name);
+      }
+      slot.state = box.state();
+      slot.since = wall;
+      changed = true;
+    }
+  }
+  if (changed) publishDevices();
+}
+
+void ShowDirector::noteOpen(DeviceSlot& slot, const Result<void>& opened, Nanos now, bool& changed) {
+  if (opened) {
+    slot.backoff = std::chrono::seconds(1);
+    slot.message.clear();
+    return;
+  }
+  if (slot.message != opened.error().message()) {
+    log::warn(kLogDirector, "device '{}' ({}): {}; retrying every {} s at most", slot.spec.name,
+              deviceBackendName(slot.spec.backend), opened.error().describe(), toSeconds(kMaxRetry));
+    changed = true;  // the status shows the new reason
+  }
+  slot.message = opened.error().message();
+  slot.nextAttempt = now + slot.backoff;
+  slot.backoff = std::min(slot.backoff * 2, kMaxRetry);
+}
+
+void ShowDirector::applyInput(Nanos until) {
+  const Nanos now = until;
+  context_.events.drainWhile([until](const Event& e) { return e.time <= until; },
+                             [this, now](Event e) {
+                               if (e.device == 0 || e.device > show_->devices.size()) return;
+                               if (e.kind != EventKind::kDialDelta && e.kind != EventKind::kButton &&
+                                   e.kind != EventKind::kDialAbsolute && e.kind != EventKind::kShuttle) {
+                                 return;
+                               }
+                               // A visitor touched something: wake the exhibit, and count as activity.
+                               if (!follower_ && policy_->noteInput(now)) applyProgramme(now);
+                               if (!player_) return;
+                               DeviceSlot& slot =
+                                   show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
+                               if (e.kind == EventKind::kButton) {
+                                 if (e.value < 0.5 || e.index >= slot.buttons.size()) return;
+                                 if (follower_ && slot.buttons[e.index] != KioskAction::kResetView) return;
+                                 switch (slot.buttons[e.index]) {
+                                   case KioskAction::kNextItem:
+                                     if (policy_->next(now)) applyProgramme(now);
+                                     break;
+                                   case KioskAction::kPreviousItem:
+                                     if (policy_->previous(now)) applyProgramme(now);
+                                     break;
+                                   case KioskAction::kResetView: context_.show.resetTransforms(); break;
+                                   case KioskAction::kNone: break;
+                                 }
+                                 return;
+                               }
+                               slot.dials.apply(e, context_.show);
+                             });
+}
+
+void ShowDirector::applyOutputInput(Nanos now) {
+  std::array<Event, 64> input;
+  const auto apply = [&](std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) {
+      Event& e = input[i];
+      e.time = now;
+      // A visitor at the keyboard or mouse counts as activity (a press or a move, not a release).
+      if ((e.kind == EventKind::kPointerMotion || e.value > 0.5) && !follower_ && policy_->noteInput(now)) {
+        applyProgramme(now);
+      }
+      if (e.kind == EventKind::kKey && views_ && views_->applyKey(e)) continue;
+      if (e.kind == EventKind::kPointerButton) {
+        pointerHeld_ = e.value > 0.5;
+        continue;
+      }
+      // The pointer turns the viewer while a button is held (dragging), so that a pointer merely
+      // crossing the window leaves the view alone.
+      if (e.kind == EventKind::kPointerMotion && !pointerHeld_) continue;
+      navigator_.apply(e, context_.show);
+    }
+  };
+  while (const std::size_t n = context_.output.takeInput(input)) {
+    apply(n);
+    if (n < input.size()) break;
+  }
+  // Keyboards and mice of a KMS kiosk (evdev): the same way as the window's.
+  if (keyboardsAndMice_) {
+    while (const std::size_t n = keyboardsAndMice_->takeInput(input)) {
+      apply(n);
+      if (n < input.size()) break;
+    }
+  }
+  if (lastNavigate_.count() >= 0 && now > lastNavigate_) {
+    navigator_.advance(std::chrono::duration<double>(now - lastNavigate_).count(), context_.show);
+  }
+  lastNavigate_ = now;
+}
+
+void ShowDirector::advanceShuttles(Nanos now) {
+  // Shuttle rings held off-centre turn the show by the show time since the last frame.
+  if (player_ && lastAdvance_.count() >= 0 && now > lastAdvance_) {
+    for (DeviceSlot& slot : show_->devices) slot.dials.advance(now - lastAdvance_, context_.show);
+  }
+  lastAdvance_ = now;
+}
+
+void ShowDirector::applyProgramme(Nanos now) {
+  // An item that fails moves the policy on; at most one round of the list per call.
+  for (std::size_t attempt = 0; attempt < 64; ++attempt) {
+    const Programme& p = policy_->current();
+    if (p.generation == appliedGeneration_) return;
+    appliedGeneration_ = p.generation;
+    player_ = nullptr;
+    commands_.markShowReset();  // every item starts its own Show: the commands so far no longer act
+    const bool wantOff = p.display == DisplayState::kOff;
+    if (wantOff && displayOn_ && !displayOffUnsupported_) {
+      if (auto r = context_.output.setDisplayPower(false); r) {
+        displayOn_ = false;
+      } else {
+        displayOffUnsupported_ = true;
+        log::warn(kLogDirector, "cannot switch the display off ({}); showing black instead", r.error().message());
+      }
+    } else if (!wantOff && !displayOn_) {
+      if (auto r = context_.output.setDisplayPower(true); !r) {
+        log::error(kLogDirector, "cannot switch the display back on: {}", r.error().describe());
+      }
+      displayOn_ = true;
+    }
+    if (!p.item || p.display != DisplayState::kOn) {
+      releaseItemTextures({});
+      context_.show = runtime::Show();
+    } else {
+      const std::string key = entryKey(p.item->entry);
+      releaseItemTextures(key);
+      const auto found = show_->players.find(key);
+      Result<void> started = fail(Errc::kInternal, "no player");
+      if (found == show_->players.end()) {
+        const auto why = show_->unplayable.find(key);
+        started = std::unexpected(why != show_->unplayable.end() ? why->second
+                                                                 : Error(Errc::kInternal, "item was not prepared"));
+      } else {
+        found->second->useTextures(context_.renderer.textures());
+        found->second->setPlayback(playbackFor(p));
+        started = found->second->start(context_.show, now - p.itemStart, context_.fps);
+      }
+      if (!started) {
+        if (reportedFailures_.insert(key).second) {
+          log::error(kLogDirector, "'{}' cannot play: {}; {}", p.item->name, started.error().describe(),
+                     follower_ ? "showing the scene without it until the leader moves on" : "moving on");
+        }
+        if (follower_) break;  // the leader decides what plays next
+        policy_->itemFailed(now);
+        continue;
+      }
+      player_ = found->second.get();
+    }
+    log::info(kLogDirector, "{}", policy_->describe());
+    if (context_.supervisor) context_.supervisor->status(policy_->describe());
+    publishShow();
+    saveState(now);
+  }
+}
+
+void ShowDirector::updateStreams(Nanos now) {
+  bool changed = false;
+  std::size_t movie = 0;  // as lockedMovieFrames() counts them
+  for (LoadedTexture& t : show_->textures) {
+    if (!t.stream) continue;
+    if (follower_) {
+      t.stream->setLeaderFrame(movie < leaderMovies_.textures.size() ? leaderMovies_.textures[movie] : -1);
+      ++movie;
+    }
+    const bool live = t.stream->update(now, context_.renderer.textures(), t.name);
+    if (follower_) countLeaderFrame(t.stream->leaderFrameResult());
+    const std::optional<SourceState> device = t.stream->deviceState();
+    if (live == t.live && device == t.deviceState) continue;
+    t.deviceState = device;
+    t.since = context_.clock.wallNow();
+    changed = true;
+    if (live == t.live) continue;
+    t.live = live;
+    if (!live && t.image) {
+      if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
+        log::warn(kLogDirector, "texture '{}': {}", t.name, r.error().describe());
+      }
+    }
+  }
+  if (changed) {
+    publishStreams();
+    publishDevices();  // a camera's row follows the stream that shows it
+  }
+}
+
+void ShowDirector::saveState(Nanos now) {
+  lastSave_ = now;
+  if (context_.state && show_->manifest.kiosk.resume) context_.state->save(policy_->resumePoint(now));
+}
+
+Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
+  pollReload(frame);
+  pollTextures();
+  handleControls(frame);
+  const Nanos now = frame.time;
+  serviceDevices(now);
+  applyInput(now);
+  applyOutputInput(now);
+  advanceShuttles(now);
+  // A frame-locked follower's programme is the leader's (followProgramme): it decides nothing.
+  if (!follower_ && policy_->update(now, context_.clock.wallNow())) applyProgramme(now);
+  if (player_) {
+    // A follower's movie item shows the leader's movie frame (none on a leader: it decides).
+    if (follower_) player_->setLeaderFrame(leaderMovies_.item);
+    const Result<void> r = player_->beforeDraw(frame, context_.show);
+    if (r && follower_) countLeaderFrame(player_->leaderFrameResult());
+    if (!r) {
+      log::error(kLogDirector, "'{}' stopped: {}; moving on", policy_->current().item->name, r.error().describe());
+      if (follower_) {
+        player_ = nullptr;
+      } else {
+        policy_->itemFailed(now);
+        applyProgramme(now);
+      }
+    } else if (player_->ended() && !follower_) {
+      policy_->itemEnded(now);
+      applyProgramme(now);
+    }
+  }
+  updateStreams(now);
+  // Which movie frame the item and each texture show in which frame (BASALT_LOG=kiosk=debug):
+  // frame-locked nodes are compared with it.
+  if (player_ && policy_->current().item) {
+    if (const std::int64_t shown = player_->shownFrame(); shown >= 0) {
+      log::debug(kLogDirector, "frame {}: item '{}' shows movie frame {}", frame.frame, policy_->current().item->name,
+                 shown);
+    }
+  }
+  for (const LoadedTexture& t : show_->textures) {
+    if (!t.stream) continue;
+    if (const std::int64_t shown = t.stream->shownFrame(); shown >= 0) {
+      log::debug(kLogDirector, "frame {}: texture '{}' shows movie '{}' frame {}", frame.frame, t.name, t.source,
+                 shown);
+    }
+  }
+  // Used up: the next frame brings its own (none: each movie keeps to its own timeline).
+  leaderMovies_ = {};
+  if (now - lastSave_ >= kSaveEvery) saveState(now);
+  return {};
+}
+
+void ShowDirector::countLeaderFrame(LeaderFrameResult result) {
+  if (result == LeaderFrameResult::kCorrected) ++movieCounts_.corrected;
+  if (result == LeaderFrameResult::kLate) ++movieCounts_.late;
+}
+
+LockedMovieFrames ShowDirector::lockedMovieFrames() const {
+  LockedMovieFrames l;
+  const auto number = [](std::int64_t shown) {
+    return shown >= 0 && shown <= std::numeric_limits<std::int32_t>::max() ? static_cast<std::int32_t>(shown) : -1;
+  };
+  if (player_ && policy_ && policy_->current().item) l.item = number(player_->shownFrame());
+  if (!show_) return l;
+  std::size_t movie = 0;
+  for (const LoadedTexture& t : show_->textures) {
+    if (!t.stream || movie == l.textures.size()) continue;
+    l.textures[movie++] = number(t.stream->shownFrame());
+  }
+  return l;
+}
+
+void ShowDirector::runCommand(const FrameContext& frame, ControlRequest& request) {
+  auto& reply = *request.reply;
+  if (follower_) {
+    // One show for the group: a command run here alone would part this node's picture from the others'.
+    reply.answer(409,
+                 "this node follows its frame-lock leader, which runs script commands on every node: send the "
+                 "command to the leader's control server");
+    return;
+  }
+  const bool lockLeader = locked_;
+  if (lockLeader && request.argument.size() > kCommandTextBytes) {
+    reply.answer(400, fmt::format("a frame-locked leader runs commands of at most {} bytes (it sends them to its "
+                                  "followers); this one has {}",
+                                  kCommandTextBytes, request.argument.size()));
+    return;
+  }
+  auto out = runLeaderCommand(request.argument);
+  if (!out) {
+    reply.answer(out.error().code() == Errc::kUnsupported ? 501 : 400, out.error().describe());
+    return;
+  }
+  if (lockLeader) {
+    const std::uint32_t seq = commands_.add(request.argument);
+    log::info(kLogDirector, "frame {}: runs command {} for the frame-locked group: {}", frame.frame, seq,
+              request.argument);
+  }
+  reply.answer(200, *out);
+}
+
+Result<std::string> ShowDirector::runLeaderCommand(std::string_view command) {
+  return runScriptCommand(command, {context_.show, &context_.renderer.textures(),
+                                    show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
+}
+
+const LockCommandLog* ShowDirector::commandLog() const { return locked_ && !follower_ ? &commands_ : nullptr; }
+
+void ShowDirector::setLocked(bool leader, std::chrono::milliseconds patience) {
+  locked_ = true;
+  follower_ = !leader;
+  patience_ = patience;
+  if (show_) alignStreams();
+  // A leader's movie item that started with the show (before the lock) starts again on the
+  // group's timeline, from the item's start: the followers place theirs there.
+  const Programme* p = policy_ ? &policy_->current() : nullptr;
+  if (leader && player_ && p && p->item && p->item->entry.kind == EntryKind::kMovie) {
+    player_->setPlayback(playbackFor(*p));
+    if (auto r = player_->start(context_.show, context_.clock.now() - p->itemStart, context_.fps); !r) {
+      log::error(kLogDirector, "'{}' cannot play on the group's timeline: {}", p->item->name, r.error().describe());
+    }
+  }
+}
+
+ItemPlayer::Playback ShowDirector::playbackFor(const Programme& p) const {
+  ItemPlayer::Playback playback;
+  // An item with a duration loops until it is up; so does the only item of its list. One
+  // without, in a list of several, plays once and the list moves on at its end.
+  playback.loop = (p.item && p.item->duration > Nanos{0}) || p.count <= 1;
+  playback.manualClock = context_.clock.isManual();
+  // Frame-locked, a movie's frames fall on the group's timeline from the item's start.
+  if (locked_) playback.timelineStart = p.itemStart;
+  playback.patience = patience_;
+  return playback;
+}
+
+void ShowDirector::alignStreams() {
+  for (LoadedTexture& t : show_->textures) {
+    if (t.stream) t.stream->alignTo(mediaStart_, patience_);
+  }
+}
+
+LockedProgramme ShowDirector::lockedProgramme() const {
+  LockedProgramme l;
+  l.present = true;
+  const Programme& p = policy_->current();
+  l.hasItem = p.item != nullptr;
+  l.mode = static_cast<std::uint8_t>(p.mode);
+  l.display = static_cast<std::uint8_t>(p.display);
+  l.index = static_cast<std::uint32_t>(p.index);
+  l.itemStartNs = p.itemStart.count();
+  l.mediaStartNs = mediaStart_.count();
+  l.reloads = static_cast<std::uint32_t>(reloadsApplied_);
+  if (p.item) l.setItemName(p.item->name);
+  std::size_t movie = 0;
+  for (const LoadedTexture& t : show_->textures) {
+    if (!t.stream || movie == l.moviePassNs.size()) continue;
+    l.moviePassNs[movie++] = t.stream->passDuration().count();
+  }
+  return l;
+}
+
+void ShowDirector::leaderRestarted() {
+  if (!follower_) return;
+  // The leader's show started anew: so does this node's (the commands run on the old one are
+  // gone on the leader), and the new leader's reload count is taken as it comes.
+  log::info(kLogDirector, "the frame-lock leader restarted; reloading this node's show");
+  leaderReloads_.reset();
+  requestReload();
+}
+
+bool ShowDirector::followProgramme(const LockedProgramme& l, Nanos showTime) {
+  if (!follower_ || !policy_) return false;
+  // The leader reloaded its manifest: so does this node (its own copy of the show folder).
+  if (leaderReloads_ && *leaderReloads_ != l.reloads) {
+    log::info(kLogDirector, "the frame-lock leader reloaded its show; reloading this node's");
+    requestReload();
+  }
+  leaderReloads_ = l.reloads;
+  bool changed = false;
+  std::size_t movie = 0;
+  for (LoadedTexture& t : show_->textures) {
+    if (!t.stream || movie == l.moviePassNs.size()) continue;
+    t.stream->setLeaderPass(Nanos{l.moviePassNs[movie++]});
+  }
+  if (Nanos{l.mediaStartNs} != mediaStart_) {
+    mediaStart_ = Nanos{l.mediaStartNs};
+    alignStreams();
+    changed = true;
+  }
+  if (l.mode > 2 || l.display > 2) return changed;  // decodeFrame rejects these
+  const std::string item = l.itemName();
+  if (policy_->follow(static_cast<KioskMode>(l.mode), static_cast<DisplayState>(l.display), l.hasItem, l.index, item,
+                      Nanos{l.itemStartNs})) {
+    const Programme& p = policy_->current();
+    if (l.hasItem && (!p.item || p.item->name != item)) {
+      log::warn(kLogDirector,
+                "the frame-lock leader plays '{}' ({}), which this node's show does not have at that "
+                "place; check that every node has the same show folder",
+                item, l.index + 1);
+    }
+    applyProgramme(showTime);
+    changed = true;
+  }
+  return changed;
+}
+
+void ShowDirector::releaseItemTextures(const std::string& nextKey) {
+  if (!itemKey_.empty() && itemKey_ == nextKey) return;  // the same item again keeps its images
+  render::TextureRegistry& textures = context_.renderer.textures();
+  std::vector<std::string> now = textures.names();
+  if (!itemKey_.empty() || !nextKey.empty()) {
+    for (const std::string& name : now) {
+      if (std::binary_search(texturesBeforeItem_.begin(), texturesBeforeItem_.end(), name)) continue;
+      if (std::any_of(show_->textures.begin(), show_->textures.end(),
+                      [&](const LoadedTexture& t) { return t.name == name; })) {
+        continue;  // the manifest's: the director's own
+      }
+      textures.remove(name);
+    }
+  }
+  itemKey_ = nextKey;
+  texturesBeforeItem_ = textures.names();  // sorted
+}
+
+Result<void> ShowDirector::afterDraw(const FrameContext& frame, render::Output& output) {
+  if (player_) {
+    // Items that draw over the scene (a movie's picture) do it before anything reads the frame.
+    if (auto r = player_->afterDraw(frame, output); !r) {
+      log::error(kLogDirector, "'{}' stopped: {}; moving on", policy_->current().item->name, r.error().describe());
+      policy_->itemFailed(frame.time);
+      applyProgramme(frame.time);
+    }
+  }
+  std::shared_ptr<SnapshotRequest> request;
+  if (!context_.board.snapshotRequests().pop(request)) return {};
+  Image image;
+  const auto read = output.readBack(image);
+  do {
+    if (read) {
+      request->answer(true, image, {});
+    } else {
+      request->answer(false, {}, read.error().describe());
+    }
+  } while (context_.board.snapshotRequests().pop(request));
+  return {};
+}
+
+void ShowDirector::afterPresent(const FrameContext& /*frame*/) {
+  // LAVA's performance meter, published when it has taken a new sample (every 2 s).
+  const runtime::PerformanceMeter& meter = context_.show.performance();
+  if (meter.updates != performanceUpdates_ && meter.updates > 0) {
+    performanceUpdates_ = meter.updates;
+    context_.board.publishPerformance(meter);
+  }
+  if (texturesPending_) {
+    texturesPending_ = false;
+    loadTexturesInBackground();
+  }
+}
+
+void ShowDirector::publishShow() {
+  const Programme& p = policy_->current();
+  ShowStatus s;
+  s.name = show_->manifest.name;
+  s.manifest = show_->manifest.file.string();
+  s.output = context_.output.describe();
+  s.open = p.mode != KioskMode::kClosed;
+  s.mode = std::string(kioskModeName(p.mode));
+  s.display = std::string(displayStateName(p.display));
+  s.item = p.item ? p.item->name : std::string();
+  s.index = p.item ? p.index + 1 : 0;
+  s.count = p.count;
+  s.description = policy_->describe();
+  s.schedule = scheduleForStatus_;
+  context_.board.publishShow(std::move(s));
+}
+
+void ShowDirector::publishDevices() {
+  std::vector<DeviceStatus> out;
+  const WallTime wall = context_.clock.wallNow();
+  for (const DeviceSlot& slot : show_->devices) {
+    DeviceStatus d;
+    d.name = slot.spec.name;
+    d.kind = std::string(deviceKindName(slot.spec.kind));
+    d.backend = std::string(deviceBackendName(slot.spec.backend));
+    d.state = slot.dialBox ? std::string(devices::deviceStateName(slot.dialBox->state())) : "absent";
+    d.message = slot.message.empty() && slot.dialBox ? slot.dialBox->info().name : slot.message;
+    d.since = slot.since;
+    if (slot.spec.kind == DeviceKind::kCamera && !slot.dialBox) cameraRow(d, slot);
+    if (d.since == WallTime{}) d.since = wall;
+    out.push_back(std::move(d));
+  }
+  context_.board.publishDevices(std::move(out));
+}
+
+void ShowDirector::cameraRow(DeviceStatus& d, const DeviceSlot& slot) const {
+  // A camera is opened by the texture stream of the media that shows it: its row is that
+  // stream's state.
+  for (const LoadedTexture& t : show_->textures) {
+    const MediaSpec* media = t.source.empty() ? nullptr : show_->manifest.findMedia(t.source);
+    if (!media || media->kind != MediaKind::kCamera || media->device != slot.spec.name) continue;
+    if (t.deviceState) {
+      d.state =
+          *t.deviceState == SourceState::kLive ? "live" : (*t.deviceState == SourceState::kLost ? "lost" : "absent");
+    } else {
+      d.state = t.live ? "live" : (t.stream ? "lost" : "absent");
+    }
+    d.message = t.stream ? fmt::format("shown by texture '{}': {}", t.name, t.stream->describe())
+                         : fmt::format("texture '{}': {}", t.name, t.streamState);
+    d.since = t.since;
+    return;
+  }
+  if (!slot.unavailable.starts_with("a camera")) return;  // this build cannot open it: absent, saying why
+  d.state = "idle";
+  d.message =
+      "no texture shows it (a [textures.NAME] with source = a camera [media] naming it); a LAVA script's "
+      "video texture opens it itself";
+}
+
+void ShowDirector::publishStreams() {
+  std::vector<StreamStatus> out;
+  const WallTime wall = context_.clock.wallNow();
+  for (const LoadedTexture& t : show_->textures) {
+    if (t.source.empty()) continue;
+    const MediaSpec* media = show_->manifest.findMedia(t.source);
+    if (!media || media->kind == MediaKind::kImage) continue;
+    StreamStatus s;
+    s.name = t.source;
+    s.kind = std::string(mediaKindName(media->kind));
+    s.state = t.live ? "playing" : (t.stream ? "waiting" : "absent");
+    // A camera that is gone while its texture shows the on_loss picture is not playing.
+    if (t.deviceState == SourceState::kLost) s.state = "lost";
+    if (t.deviceState == SourceState::kWaiting) s.state = "waiting";
+    s.message = t.stream ? t.stream->describe() : t.streamState;
+    if (!t.live) s.message += t.image ? "; showing the fallback image" : "; showing black";
+    s.since = t.since == WallTime{} ? wall : t.since;
+    out.push_back(std::move(s));
+  }
+  context_.board.publishStreams(std::move(out));
+}
+
+}  // namespace basalt::kiosk

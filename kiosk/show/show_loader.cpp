@@ -1,0 +1,194 @@
+#include "kiosk/show/show_loader.h"
+
+#include <mutex>
+
+#include <fmt/format.h>
+#include <fmt/std.h>
+
+#include "kiosk/manifest/content_check.h"
+#include "media/image_io.h"
+#include "runtime/log.h"
+#include "sim/synthetic_dial.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Loader, "kiosk");
+
+namespace {
+
+struct Factories {
+  std::mutex mutex;
+  std::array<StreamFactory, 3> streams;  // by MediaKind; guarded by mutex
+  std::array<DialBoxFactory, 6> dials;   // by DeviceBackend; guarded by mutex
+};
+
+Factories& factories() {
+  static Factories f;
+  return f;
+}
+
+Result<std::unique_ptr<devices::DialBox>> makeDialBox(const DeviceSpec& spec, const Clock& clock) {
+  DialBoxFactory factory;
+  {
+    std::lock_guard lock(factories().mutex);
+    factory = factories().dials[static_cast<std::size_t>(spec.backend)];
+  }
+  if (factory) return factory(spec, clock);
+  if (spec.backend == DeviceBackend::kSynthetic) {
+    std::vector<sim::ScriptedInput> script;
+    script.reserve(spec.script.size());
+    for (const SyntheticInput& in : spec.script) {
+      const EventKind kind =
+          in.button ? EventKind::kButton : (in.shuttle ? EventKind::kShuttle : EventKind::kDialDelta);
+      script.push_back({in.at, kind, in.index, in.value});
+    }
+    return std::make_unique<sim::SyntheticDial>(std::move(script), clock, spec.loop);
+  }
+  return fail(Errc::kUnsupported,
+              fmt::format("this build has no {} dial box backend", deviceBackendName(spec.backend)));
+}
+
+}  // namespace
+
+void setStreamFactory(MediaKind kind, StreamFactory factory) {
+  std::lock_guard lock(factories().mutex);
+  factories().streams[static_cast<std::size_t>(kind)] = std::move(factory);
+}
+
+void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory) {
+  std::lock_guard lock(factories().mutex);
+  factories().dials[static_cast<std::size_t>(backend)] = std::move(factory);
+}
+
+std::string entryKey(const EntrySpec& entry) { return entry.path.empty() ? entry.text : entry.path.string(); }
+
+std::optional<Image> readTextureImage(const std::string& texture, const std::filesystem::path& file) {
+  auto image = media::readImage(file);
+  if (!image) {
+    log::warn(kLogLoader, "texture '{}': cannot read {}: {}", texture, file, image.error().message());
+    return std::nullopt;
+  }
+  return std::move(*image);
+}
+
+Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock, bool readImages) {
+  auto show = std::make_unique<LoadedShow>();
+  show->manifest = std::move(manifest);
+  const Manifest& m = show->manifest;
+  if (m.kiosk.schedule.present) {
+    auto schedule = Schedule::create(m.kiosk.schedule);
+    if (!schedule) return std::unexpected(schedule.error().withContext("the schedule's time zone"));
+    show->schedule = std::move(*schedule);
+  }
+
+  // Every item the show may play, prepared once.
+  std::vector<const EntrySpec*> entries{&m.entry};
+  for (const PlaylistItem& item : m.kiosk.playlist) entries.push_back(&item.entry);
+  for (const PlaylistItem& item : m.kiosk.attract.items) entries.push_back(&item.entry);
+  if (m.kiosk.schedule.standby) entries.push_back(&*m.kiosk.schedule.standby);
+  for (const EntrySpec* entry : entries) {
+    const std::string key = entryKey(*entry);
+    if (show->players.contains(key) || show->unplayable.contains(key)) continue;
+    auto player = prepareItem(*entry, m);
+    if (player) {
+      show->players.emplace(key, std::move(*player));
+    } else {
+      log::warn(kLogLoader, "{}", player.error().describe());
+      show->unplayable.emplace(key, player.error());
+    }
+  }
+
+  // Devices and their bindings: LAVA's dial table for a dial box no binding mentions.
+  for (const DeviceSpec& spec : m.devices) {
+    DeviceSlot slot;
+    slot.spec = spec;
+    if (spec.kind == DeviceKind::kDialBox) {
+      auto box = makeDialBox(spec, clock);
+      if (box) {
+        slot.dialBox = std::move(*box);
+      } else {
+        slot.unavailable = box.error().message();
+      }
+      // LAVA's dial table with the device's gain and acceleration, then each binding's
+      // override of one dial (the others keep LAVA's action).
+      slot.dials = runtime::Bindings::lavaDefaults();
+      slot.dials.setGain(spec.gain);
+      slot.dials.setAcceleration(spec.acceleration);
+      for (const BindingSpec& b : m.bindings) {
+        if (b.device != spec.name) continue;
+        if (b.button) {
+          slot.buttons[b.index] = b.kioskAction;
+          continue;
+        }
+        runtime::DialBinding dial = slot.dials.dial(b.index);
+        if (b.actionGiven || b.gainGiven) {
+          dial.action = b.action;
+          dial.gain = b.gain;
+        }
+        dial.acceleration = b.acceleration.value_or(spec.acceleration);
+        dial.invert = b.invert;
+        slot.dials.setDial(b.index, dial);
+      }
+    } else {
+      // A camera is opened and kept by the texture stream of the media that shows it (its own
+      // DeviceManager); its slot only names it in the status.
+      StreamFactory cameras;
+      {
+        std::lock_guard lock(factories().mutex);
+        cameras = factories().streams[static_cast<std::size_t>(MediaKind::kCamera)];
+      }
+      slot.unavailable = cameras ? fmt::format("a camera: its state is on the stream of the media that shows it")
+                                 : fmt::format("this build has no {} camera backend", deviceBackendName(spec.backend));
+    }
+    slot.message = slot.unavailable;
+    show->devices.push_back(std::move(slot));
+  }
+
+  // Textures: images read now; streams made now and started by their first update.
+  for (const TextureSpec& spec : m.textures) {
+    LoadedTexture t;
+    t.name = spec.name;
+    t.source = spec.source;
+    if (!spec.file.empty()) t.imageFile = spec.file;
+    if (const MediaSpec* media = m.findMedia(spec.source)) {
+      if (media->kind == MediaKind::kImage) {
+        t.imageFile = media->file;
+      } else {
+        StreamFactory factory;
+        {
+          std::lock_guard lock(factories().mutex);
+          factory = factories().streams[static_cast<std::size_t>(media->kind)];
+        }
+        if (factory) {
+          auto stream = factory(*media, m, clock);
+          if (stream) {
+            t.stream = std::move(*stream);
+          } else {
+            t.streamState = stream.error().message();
+          }
+        } else {
+          t.streamState =
+              media->kind == MediaKind::kMovie ? "this build has no movie player" : "this build has no camera stream";
+        }
+        t.imageFile = spec.fallback;
+      }
+    }
+    if (readImages && !t.imageFile.empty()) t.image = readTextureImage(t.name, t.imageFile);
+    show->textures.push_back(std::move(t));
+  }
+  return show;
+}
+
+Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path& file, const Clock& clock,
+                                                    Diagnostics& diagnostics) {
+  ReadOptions options;
+  options.fileCheckers = &contentCheckers();
+  auto manifest = readManifest(file, diagnostics, options);
+  if (!manifest) {
+    return fail(Errc::kParse, fmt::format("{} has {} problem{}", file.string(), diagnostics.errorCount(),
+                                          diagnostics.errorCount() == 1 ? "" : "s"));
+  }
+  return loadShow(std::move(*manifest), clock, true);
+}
+
+}  // namespace basalt::kiosk

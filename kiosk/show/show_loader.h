@@ -1,0 +1,150 @@
+#pragma once
+
+/// \file
+/// \brief Turning a validated manifest into what plays: item players, devices with their
+/// bindings, textures and their fallbacks, streams, the schedule. Loading reads files and opens
+/// nothing on the screen, so it runs off the frame loop's thread (at start and on SIGHUP) while
+/// the current show keeps playing; the director installs the result between two frames.
+///
+/// Seams for the parts other efforts build: setDialBoxFactory() for the hid and replay dial
+/// boxes, setStreamFactory() for movie and camera textures (kiosk/show/show_items.h has the item
+/// seam). Without one, the device or stream is reported absent with the reason, its bindings
+/// stay quiet and its texture shows the fallback: the show goes on.
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "devices/dial_box.h"
+#include "kiosk/manifest/manifest.h"
+#include "kiosk/policy/kiosk_policy.h"
+#include "kiosk/policy/schedule.h"
+#include "kiosk/show/show_items.h"
+#include "kiosk/status/status_board.h"
+#include "render/texture_registry.h"
+#include "runtime/bindings.h"
+#include "runtime/clock.h"
+#include "runtime/frame_queue.h"
+#include "runtime/image.h"
+
+namespace basalt::kiosk {
+
+/// \brief A texture fed by a movie or a camera.
+///
+/// Threading: made on the loader's thread; update() on the frame loop's thread, never blocking.
+class TextureStream {
+ public:
+  virtual ~TextureStream() = default;
+  /// \brief Shows the frame due at `showTime` as texture `name`; false while the stream has
+  /// nothing to show (not started, unplugged, broken), when the fallback is shown instead.
+  virtual bool update(Nanos showTime, render::TextureRegistry& textures, const std::string& name) = 0;
+  /// \brief One line for the status page: state and why.
+  [[nodiscard]] virtual std::string describe() const = 0;
+  /// \brief A camera's own state as of the last update() (it can be lost while the texture
+  /// still shows something: its on_loss picture); none for streams without a device.
+  [[nodiscard]] virtual std::optional<SourceState> deviceState() const { return std::nullopt; }
+  /// \brief Frame-locked nodes: play as if started at show time `origin` (frame 0 due then, the
+  /// frame at `t - origin` due at `t`, looping where the media loops), so that every node shows
+  /// the same frame whenever it started; wait up to `patience` each update for the frame due (a
+  /// follower draws the leader's frame; a manual clock waits anyway). Streams that play no file
+  /// (cameras) ignore it.
+  virtual void alignTo(Nanos origin, std::chrono::milliseconds patience) {
+    (void)origin;
+    (void)patience;
+  }
+  /// \brief Frame-locked: one pass of the leader's loop of this stream (0: unknown yet), for
+  /// placing a late joiner in the right loop (the leader's passes are its file's length, which
+  /// can differ from frames x frame duration by the file's timestamp rounding).
+  virtual void setLeaderPass(Nanos pass) { (void)pass; }
+  /// \brief One pass of this stream's loop on its timeline, once it has looped (0 before, and
+  /// for streams that are not movies).
+  [[nodiscard]] virtual Nanos passDuration() const { return Nanos{0}; }
+  /// \brief The number of the movie frame the last update() showed; -1 before the first, and
+  /// for streams that are not movies.
+  [[nodiscard]] virtual std::int64_t shownFrame() const { return -1; }
+  /// \brief Frame-locked followers: the movie frame the leader's stream shows in the coming
+  /// frame (its shownFrame()), which update() shows exactly; -1: none given (the stream's own
+  /// timeline).
+  virtual void setLeaderFrame(std::int64_t frame) { (void)frame; }
+  /// \brief What the last update() did with the leader's frame.
+  [[nodiscard]] virtual LeaderFrameResult leaderFrameResult() const { return LeaderFrameResult::kNone; }
+};
+
+using StreamFactory = std::function<Result<std::unique_ptr<TextureStream>>(const MediaSpec& media, const Manifest& show,
+                                                                           const Clock& clock)>;
+/// \brief Registers the stream maker for movies or cameras (call before the first show loads).
+void setStreamFactory(MediaKind kind, StreamFactory factory);
+
+using DialBoxFactory =
+    std::function<Result<std::unique_ptr<devices::DialBox>>(const DeviceSpec& device, const Clock& clock)>;
+/// \brief Registers the dial box maker for a backend (hid, replay). The synthetic backend is
+/// built in.
+void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory);
+
+/// \brief An open of a dial box running on the director's device thread (system clock).
+struct PendingOpen;
+
+/// \brief One device of a show, with what its inputs do.
+struct DeviceSlot {
+  DeviceSpec spec;
+  std::unique_ptr<devices::DialBox> dialBox;  ///< null when this build cannot make it
+  std::string unavailable;                    ///< why there is no device, when there is none
+  runtime::Bindings dials;                    ///< what its dials do to the show
+  std::array<KioskAction, 32> buttons{};      ///< what its buttons do to the kiosk
+  // Kept by the director:
+  devices::DeviceState state = devices::DeviceState::kAbsent;
+  std::string message;
+  WallTime since{};
+  Nanos nextAttempt{0};
+  Nanos backoff{std::chrono::seconds(1)};
+  /// An open running on the director's device thread: until it is done, that thread owns the box.
+  std::shared_ptr<PendingOpen> opening;
+};
+
+/// \brief One named texture of a show.
+struct LoadedTexture {
+  std::string name;
+  std::string source;                      ///< the media it shows, "" for a plain image
+  std::filesystem::path imageFile;         ///< the image to show, or the fallback for a stream
+  std::optional<Image> image;              ///< imageFile, once read
+  std::unique_ptr<TextureStream> stream;   ///< movies and cameras
+  std::string streamState;                 ///< why there is no stream, when there is none
+  bool live = false;                       ///< kept by the director
+  std::optional<SourceState> deviceState;  ///< the stream's deviceState() at the last update
+  WallTime since{};                        ///< when `live` or `deviceState` last changed (kept by the director)
+};
+
+/// \brief Everything a manifest needs to play.
+struct LoadedShow {
+  Manifest manifest;
+  std::optional<Schedule> schedule;
+  std::map<std::string, std::unique_ptr<ItemPlayer>, std::less<>> players;  ///< by entryKey()
+  std::map<std::string, Error, std::less<>> unplayable;                     ///< by entryKey()
+  std::vector<DeviceSlot> devices;
+  std::vector<LoadedTexture> textures;
+};
+
+/// \brief The key of an entry in LoadedShow::players.
+std::string entryKey(const EntrySpec& entry);
+
+/// \brief Prepares a validated manifest. Errors only for what makes the show impossible (a time
+/// zone that vanished); unplayable items, devices and streams are recorded and reported.
+/// Without `readImages` texture images are left for the director to read in the background
+/// (start-up: the first frame does not wait for image decoding).
+[[nodiscard]] Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock,
+                                                           bool readImages = true);
+
+/// \brief Reads a texture's image, or says why not (a warning) and returns nothing.
+std::optional<Image> readTextureImage(const std::string& texture, const std::filesystem::path& file);
+
+/// \brief Reads, validates and loads `file`: what a reload does on its own thread.
+[[nodiscard]] Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path& file, const Clock& clock,
+                                                                  Diagnostics& diagnostics);
+
+}  // namespace basalt::kiosk

@@ -1,0 +1,657 @@
+#include "kiosk/show/stream_factories.h"
+
+#include "kiosk/show/movie_item.h"
+#include "kiosk/show/script_player.h"
+#include "kiosk/show/trace_video_glue.h"
+
+#include <algorithm>
+#include <atomic>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <fmt/std.h>
+
+#include "devices/hid/hid_backend.h"
+#include "devices/libcamera/libcamera_camera.h"
+#include "devices/serial/sgi_dial_box.h"
+#include "devices/v4l2/v4l2_camera.h"
+#include "media/mjpeg_decoder.h"
+#include "media/movie_player.h"
+#include "render/stream_texture.h"
+#include "runtime/log.h"
+#include "runtime/test_pattern.h"
+#include "sim/hid_recording.h"
+#include "sim/providers.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Streams, "kiosk");
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Dial boxes found by a rule
+
+class MatchedDialBox final : public devices::DialBox {
+ public:
+  MatchedDialBox(std::unique_ptr<devices::DeviceProvider> provider, devices::DeviceRequest request, const Clock& clock)
+      : DialBox(devices::DeviceInfo{request.name, std::string(provider->backend()), "", 0, 0, "", ""}, 0, 0),
+        provider_(std::move(provider)),
+        request_(std::move(request)),
+        clock_(clock),
+        inner_(1024) {}
+
+  ~MatchedDialBox() override { close(); }
+  MatchedDialBox(const MatchedDialBox&) = delete;
+  MatchedDialBox& operator=(const MatchedDialBox&) = delete;
+
+ private:
+  Result<void> doOpen() override {
+    std::string problems;
+    for (const devices::DeviceCandidate& c : provider_->enumerate()) {
+      if (c.kind != devices::DeviceKind::kDialBox || !request_.match.matches(c.info)) continue;
+      if (!c.problem.empty()) {
+        problems += fmt::format("; {}: {}", devices::describeDevice(c.info), c.problem);
+        continue;
+      }
+      auto box = provider_->openDialBox(c, request_, clock_);
+      if (!box) {
+        problems += fmt::format("; {}", box.error().describe());
+        continue;
+      }
+      Event stale;
+      while (inner_.pop(stale)) {
+      }
+      if (auto r = (*box)->open(1, inner_); !r) {
+        problems += fmt::format("; {}", r.error().describe());
+        continue;
+      }
+      device_ = std::move(*box);
+      setInfo(device_->info());
+      setShape(device_->dialCount(), device_->buttonCount());
+      return {};
+    }
+    if (problems.empty()) {
+      return fail(Errc::kNotFound, fmt::format("no {} is plugged in", request_.match.describe()));
+    }
+    return fail(Errc::kUnavailable, fmt::format("{} found but not usable{}", request_.match.describe(), problems));
+  }
+
+  void doClose() override {
+    if (device_) device_->close();
+    device_.reset();
+  }
+
+  void doService(Nanos now) override {
+    if (!device_) return;
+    device_->service(now);
+    Event e;
+    while (inner_.pop(e)) {
+      if (e.kind == EventKind::kDeviceState) continue;
+      emit(e);
+    }
+    if (device_->state() != devices::DeviceState::kLive) {
+      auto why = device_->lostReason();
+      reportLost(why ? *why
+                     : Error{Errc::kIo, fmt::format("{} stopped", devices::describeDevice(device_->info())), {}});
+    }
+  }
+
+  Result<void> doSetLight(int index, double level, bool pulse) override {
+    if (!device_) return fail(Errc::kUnavailable, "the dial box is not connected");
+    return device_->setLight(index, level, pulse);
+  }
+
+  std::unique_ptr<devices::DeviceProvider> provider_;
+  devices::DeviceRequest request_;
+  const Clock& clock_;
+  BoundedQueue<Event> inner_;  // the device's events, passed on in doService()
+  std::unique_ptr<devices::DialBox> device_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Movies
+
+class MovieStream final : public TextureStream {
+ public:
+  MovieStream(MediaSpec media, std::unique_ptr<media::MoviePlayer> player, bool manualClock)
+      : media_(std::move(media)), player_(std::move(player)), manualClock_(manualClock) {}
+
+  bool update(Nanos showTime, render::TextureRegistry& textures, const std::string& name) override {
+    leaderResult_ = LeaderFrameResult::kNone;
+    if (!started_) {
+      started_ = true;
+      if (auto r = player_->load(media_.file); !r) {
+        failure_ = r.error().message();
+        log::error(kLogStreams, "movie '{}': {}; its textures show their fallback", media_.name, r.error().describe());
+        return false;
+      }
+      player_->setRepeat(media_.loop);
+      player_->play();
+    }
+    if (!failure_.empty()) return false;
+    if (!texture_) {
+      auto texture = render::StreamTexture::create(name);
+      if (!texture) {
+        failure_ = texture.error().message();
+        log::error(kLogStreams, "movie '{}': {}", media_.name, texture.error().describe());
+        return false;
+      }
+      texture_ = std::move(*texture);
+    }
+    // Offline (ManualClock) runs wait for the frame due, so that every frame is exact; a show
+    // on the system clock never waits (the newest frame due is shown, or the last one stays),
+    // except a frame-locked follower, which must draw the leader's frame (bounded).
+    const std::chrono::milliseconds patience = manualClock_ ? std::chrono::milliseconds(10000) : patience_;
+    if (origin_ && !aligned_) {
+      align(showTime, patience);
+      // Nothing before the movie is on the group's timeline: a node that showed the clip's first
+      // frame meanwhile would show another frame than the others.
+      const media::MovieState now = player_->state();
+      if (!aligned_ && now != media::MovieState::kFailed && now != media::MovieState::kEmpty) return false;
+    }
+    FrameRef frame;
+    if (origin_ && leaderFrame_ >= 0) {
+      // A follower shows the leader's frame by its number, not by its own decoder's timestamps
+      // (a loop of its can come out a fraction of a millisecond longer than the leader's).
+      media::NumberedFrame pick = player_->frameNumbered(leaderFrame_, showTime, patience);
+      frame = std::move(pick.frame);
+      leaderResult_ = leaderFrameResultOf(pick.outcome);
+    } else {
+      if (patience.count() > 0) player_->waitForFrameDue(showTime, patience);
+      frame = player_->frameAt(showTime);
+      if (origin_ && frame && patience.count() > 0) {
+        // The frame a seek onto the group's timeline brought is due when the seek was asked for;
+        // a node that waited for it takes the frame due now as well, so that it shows what the
+        // others show in this very frame.
+        player_->waitForFrameDue(showTime, patience);
+        if (FrameRef newer = player_->frameAt(showTime)) frame = std::move(newer);
+      }
+    }
+    const media::MovieState state = player_->state();
+    if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) {
+      if (!reportedFailure_) {
+        reportedFailure_ = true;
+        const auto error = player_->error();
+        log::error(kLogStreams, "movie '{}' cannot play: {}; its textures show their fallback", media_.name,
+                   error ? error->describe() : std::string("nothing is loaded"));
+      }
+      return false;
+    }
+    auto changed = texture_->update(frame);
+    if (!changed) {
+      failure_ = changed.error().message();
+      log::error(kLogStreams, "movie '{}': {}; its textures show their fallback", media_.name,
+                 changed.error().describe());
+      player_->unload();
+      return false;
+    }
+    if (texture_->showingFallback()) return false;  // no frame yet: never a frame early
+    texture_->publish(textures);
+    return true;
+  }
+
+  void alignTo(Nanos origin, std::chrono::milliseconds patience) override {
+    if (origin_ == origin && patience_ == patience) return;
+    origin_ = origin;
+    patience_ = patience;
+    aligned_ = false;
+  }
+
+  void setLeaderPass(Nanos pass) override { leaderPass_ = pass; }
+  void setLeaderFrame(std::int64_t frame) override { leaderFrame_ = frame; }
+  [[nodiscard]] LeaderFrameResult leaderFrameResult() const override { return leaderResult_; }
+  [[nodiscard]] Nanos passDuration() const override { return started_ ? player_->passDuration() : Nanos{0}; }
+
+  [[nodiscard]] std::int64_t shownFrame() const override {
+    return started_ && failure_.empty() ? player_->currentFrame() : -1;
+  }
+
+  [[nodiscard]] std::string describe() const override {
+    if (!failure_.empty()) return fmt::format("movie {}: {}", media_.file.filename(), failure_);
+    const media::MovieInfo info = player_->info();
+    const media::MoviePlayerStats stats = player_->stats();
+    return fmt::format("movie {}: frame {} of {}, {} loops{}", media_.file.filename(), player_->currentFrame(),
+                       info.frameCount, stats.loops,
+                       stats.stalls > 0 ? fmt::format(", restarted {} times after a stall", stats.stalls) : "");
+  }
+
+ private:
+  /// Seeks to the frame due at `showTime` on the timeline that starts at origin_, due at the
+  /// show time that frame belongs to (not when the seek lands), once the clip's length is known.
+  void align(Nanos showTime, std::chrono::milliseconds patience) {
+    // Opening takes longer than a frame: the first time, wait up to a second for it.
+    // (Not loaded yet: the next update tries again; failed: update() reports it.)
+    if (!player_->waitUntilLoaded(std::max(patience, std::chrono::milliseconds(1000)))) return;
+    if (player_->state() != media::MovieState::kReady) return;
+    const Nanos frame = player_->info().frameDuration;
+    if (frame <= Nanos{0}) return;
+    // The leader's timeline: show time t is at t - origin, a loop's frames at its pass's start
+    // plus their timestamps, each pass one leader pass long.
+    const Nanos elapsed = std::max(Nanos{0}, showTime - *origin_);
+    const std::int64_t count = player_->frameCount();
+    Nanos passStart{0};
+    if (media_.loop && leaderPass_ > Nanos{0}) {
+      passStart = (elapsed / leaderPass_) * leaderPass_;
+    } else if (media_.loop && count > 0 && elapsed >= frame * count) {
+      passStart = (elapsed / (frame * count)) * (frame * count);  // the leader's pass is not known yet
+    }
+    // The frame due is the last whose timestamp is at most the time (plus the player's 1.5 ms for
+    // rounded timestamps); timestamps sit up to half a millisecond off the frame grid, so take the
+    // one before when in doubt: the update after the seek takes the next if it is due, by the same
+    // timestamps the leader reads.
+    std::int64_t index = std::max<std::int64_t>(0, (elapsed - passStart + std::chrono::microseconds(1000)) / frame);
+    if (count > 0) index = std::min(index, count - 1);
+    const Nanos timeline = passStart + frame * index;
+    player_->seekFrameDueAt(index, *origin_ + timeline, timeline);
+    aligned_ = true;
+    log::debug(kLogStreams, "movie '{}' joins the group's timeline at show time {:.3f} s: frame {}", media_.name,
+               toSeconds(showTime), index);
+  }
+
+  MediaSpec media_;
+  std::unique_ptr<media::MoviePlayer> player_;
+  std::unique_ptr<render::StreamTexture> texture_;
+  bool manualClock_;
+  std::optional<Nanos> origin_;            // frame-locked: the show time of frame 0
+  std::chrono::milliseconds patience_{0};  // frame-locked follower: how long to wait for a frame
+  bool aligned_ = false;                   // the seek onto the group's timeline is asked for
+  Nanos leaderPass_{0};                    // frame-locked follower: the leader's pass of this loop (0: unknown)
+  std::int64_t leaderFrame_ = -1;          // frame-locked follower: the leader's movie frame in the coming frame
+  LeaderFrameResult leaderResult_ = LeaderFrameResult::kNone;
+  bool started_ = false;
+  bool reportedFailure_ = false;
+  std::string failure_;
+};
+
+Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, const Manifest& /*show*/,
+                                                       const Clock& clock) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(media.file, ec)) {
+    return fail(Errc::kNotFound, "the movie file is missing", media.file.string());
+  }
+  media::MoviePlayerOptions options;
+  options.name = fmt::format("movie '{}'", media.name);
+  options.audio = media.audio;
+  auto player = media::MoviePlayer::create(options);
+  if (!player) return std::unexpected(player.error());
+  return std::make_unique<MovieStream>(media, std::move(*player), clock.isManual());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cameras
+
+/// A camera's MJPEG frames, decoded off the frame loop: the device manager's frame tap hands
+/// every JPEG the camera delivers to a media::MjpegDecoder on the producer's thread (the
+/// manager's or the backend's capture thread; the frame loop's only under a ManualClock, where
+/// the manager is stepped there), and GStreamer decodes it on its streaming thread. The decoder is
+/// made for the first JPEG; one that cannot be made is kept as the failure.
+class MjpegTap final : public devices::FrameTap {
+ public:
+  explicit MjpegTap(std::string camera) : camera_(std::move(camera)) {}
+
+  void onFrame(DeviceId /*device*/, const FrameRef& frame) override {
+    if (!frame || frame->format != PixelFormat::kMjpeg) return;
+    std::shared_ptr<media::MjpegDecoder> decoder;
+    {
+      std::lock_guard lock(mutex_);
+      if (!decoder_ && failure_.empty()) {
+        auto made = media::MjpegDecoder::create({3, fmt::format("camera '{}'", camera_)});
+        if (made) {
+          decoder_ = std::move(*made);
+        } else {
+          failure_ = made.error().describe();
+        }
+      }
+      decoder = decoder_;
+    }
+    if (decoder && decoder->push(frame)) pushed_.fetch_add(1, std::memory_order_release);
+  }
+
+  [[nodiscard]] std::shared_ptr<media::MjpegDecoder> decoder() const {
+    std::lock_guard lock(mutex_);
+    return decoder_;
+  }
+  [[nodiscard]] std::string failure() const {
+    std::lock_guard lock(mutex_);
+    return failure_;
+  }
+  /// JPEGs handed to the decoder so far.
+  [[nodiscard]] std::uint64_t pushed() const { return pushed_.load(std::memory_order_acquire); }
+
+ private:
+  std::string camera_;
+  mutable std::mutex mutex_;
+  std::shared_ptr<media::MjpegDecoder> decoder_;  // guarded by mutex_
+  std::string failure_;                           // guarded by mutex_
+  std::atomic<std::uint64_t> pushed_{0};
+};
+
+class CameraStream final : public TextureStream {
+ public:
+  CameraStream(const MediaSpec& media, std::unique_ptr<devices::DeviceProvider> provider,
+               devices::DeviceRequest request, const Clock& clock)
+      : media_(media.name),
+        onLoss_(media.onLoss),
+        lossColour_(media.lossColour),
+        clock_(clock),
+        events_(256),
+        mjpeg_(request.name),
+        manager_(clock, events_),
+        name_(request.name) {
+    manager_.setTaps(nullptr, &mjpeg_);
+    manager_.addProvider(std::move(provider));
+    requested_ = manager_.request(std::move(request)).has_value();
+    stream_ = manager_.videoStream(name_);
+  }
+  ~CameraStream() override { manager_.stop(); }
+  CameraStream(const CameraStream&) = delete;
+  CameraStream& operator=(const CameraStream&) = delete;
+
+  bool update(Nanos showTime, render::TextureRegistry& textures, const std::string& name) override {
+    if (!started_) {
+      started_ = true;
+      // On the system clock the manager opens and reopens the camera on a thread of its own;
+      // under a ManualClock it is stepped here, frame by frame, so that a run is repeatable.
+      if (!clock_.isManual()) manager_.start();
+    }
+    if (clock_.isManual()) manager_.step(showTime);
+    Event stale;
+    while (events_.pop(stale)) {
+    }
+    if (!stream_ || !requested_) return false;
+    if (!texture_) {
+      auto texture = render::StreamTexture::create(name);
+      if (!texture) {
+        log::error(kLogStreams, "camera '{}': {}", media_, texture.error().describe());
+        requested_ = false;
+        return false;
+      }
+      texture_ = std::move(*texture);
+    }
+    // A camera that cannot flip in the device is mirrored by its texture.
+    texture_->setMirror(stream_->mirrorInRenderer());
+    FrameRef frame = stream_->frameAt(showTime);
+    state_ = stream_->health().state;
+    if (state_ != SourceState::kLive) return showLoss(textures);
+    const std::optional<devices::VideoMode> mode = stream_->mode();
+    if ((frame && frame->format == PixelFormat::kMjpeg) || (mode && mode->format == PixelFormat::kMjpeg)) {
+      // The JPEG went to the decoder when the camera delivered it (MjpegTap): show the newest
+      // decoded frame due. A ManualClock run waits for the decoder, so that every run is exact.
+      if (const std::string failure = mjpeg_.failure(); !failure.empty()) {
+        if (!reportedMjpegFailure_) {
+          reportedMjpegFailure_ = true;
+          log::error(kLogStreams,
+                     "camera '{}' delivers MJPEG, which cannot be decoded: {}; its textures show their "
+                     "fallback",
+                     name_, failure);
+        }
+        return false;
+      }
+      const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_.decoder();
+      if (!decoder) return false;
+      if (clock_.isManual()) (void)decoder->waitForFinished(mjpeg_.pushed(), std::chrono::seconds(10));
+      frame = decoder->frameAt(showTime);
+    }
+    auto changed = texture_->update(frame);
+    if (!changed) {
+      log::warn(kLogStreams, "camera '{}': {}", media_, changed.error().describe());
+      return false;
+    }
+    if (*changed) showingLoss_ = false;
+    if (showingLoss_) return true;  // the loss picture stays until the camera's first new frame
+    if (texture_->showingFallback()) return false;
+    texture_->publish(textures);
+    return true;
+  }
+
+  [[nodiscard]] std::string lossName() const {
+    switch (onLoss_) {
+      case CameraLoss::kFallbackImage: return "the texture's fallback image";
+      case CameraLoss::kLastFrame: return "its last frame";
+      case CameraLoss::kTestPattern: return "a test pattern";
+      case CameraLoss::kColour:
+        return fmt::format("#{:02x}{:02x}{:02x}", lossColour_[0], lossColour_[1], lossColour_[2]);
+    }
+    return "?";
+  }
+
+  /// While the camera is lost or not there yet: what the manifest's on_loss asks for. False
+  /// leaves the texture's fallback image to the director.
+  bool showLoss(render::TextureRegistry& textures) {
+    switch (onLoss_) {
+      case CameraLoss::kFallbackImage: return false;
+      case CameraLoss::kLastFrame:
+        // The texture keeps its last frame; before the first one there is none to keep.
+        return !texture_->showingFallback();
+      case CameraLoss::kColour:
+        if (!showingLoss_) {
+          texture_->setFallbackColor(static_cast<float>(lossColour_[0]) / 255.0f,
+                                     static_cast<float>(lossColour_[1]) / 255.0f,
+                                     static_cast<float>(lossColour_[2]) / 255.0f);
+          texture_->showFallback();
+          texture_->publish(textures);
+          showingLoss_ = true;
+        }
+        return true;
+      case CameraLoss::kTestPattern:
+        if (!showingLoss_) {
+          // Drawn once per loss, at the size of the last frame shown (else 640x360), in RGBA.
+          const render::Size size = texture_->showingFallback() || texture_->view().size.width == 0
+                                        ? render::Size{640, 360}
+                                        : texture_->view().size;
+          if (!patternPool_ || patternPool_->config().width != size.width ||
+              patternPool_->config().height != size.height) {
+            patternPool_ = FramePool::create({PixelFormat::kRgba8, size.width, size.height, 1, 1, true});
+          }
+          FrameRef pattern = patternPool_->acquire();
+          if (!pattern) return false;
+          drawTestPattern(*pattern, TestPattern::kColourBars, 0, false);
+          pattern->sequence = ++patternSequence_;
+          if (auto r = texture_->update(pattern); !r) {
+            log::warn(kLogStreams, "camera '{}': test pattern: {}", media_, r.error().describe());
+            return false;
+          }
+          texture_->publish(textures);
+          showingLoss_ = true;
+        }
+        return true;
+    }
+    return false;
+  }
+
+  [[nodiscard]] std::optional<SourceState> deviceState() const override { return state_; }
+
+  [[nodiscard]] std::string describe() const override {
+    for (const devices::DeviceStatus& s : manager_.status()) {
+      if (s.name != name_) continue;
+      if (s.state == devices::DeviceState::kLive) {
+        return fmt::format("camera {}: {}{}{}", devices::describeDevice(s.device),
+                           s.mode ? devices::describeMode(*s.mode) : std::string("live"), describeMjpeg(),
+                           texture_ && texture_->mirror() ? ", mirrored by the renderer" : "");
+      }
+      return fmt::format("camera '{}' ({}) is {}: {}; showing {}", name_, s.match, devices::deviceStateName(s.state),
+                         s.lastError.empty() ? std::string("looking for it") : s.lastError, lossName());
+    }
+    return fmt::format("camera '{}' was not requested", name_);
+  }
+
+  /// For tests: the thread the camera's JPEGs are decoded on; none before the first.
+  [[nodiscard]] std::optional<std::thread::id> mjpegDecodeThread() const {
+    const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_.decoder();
+    if (!decoder || decoder->decodeThread() == std::thread::id{}) return std::nullopt;
+    return decoder->decodeThread();
+  }
+
+ private:
+  /// ", JPEG decoded off the frame loop, 2 corrupt JPEGs dropped" for an MJPEG camera.
+  [[nodiscard]] std::string describeMjpeg() const {
+    if (const std::string failure = mjpeg_.failure(); !failure.empty()) {
+      return fmt::format(", MJPEG that cannot be decoded ({}); showing {}", failure, lossName());
+    }
+    const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_.decoder();
+    if (!decoder) return "";
+    const std::uint64_t corrupt = decoder->corrupt();
+    return fmt::format(
+        ", JPEG decoded off the frame loop{}",
+        corrupt == 0 ? std::string() : fmt::format(", {} corrupt JPEG{} dropped", corrupt, corrupt == 1 ? "" : "s"));
+  }
+
+  std::string media_;
+  CameraLoss onLoss_;
+  std::array<std::uint8_t, 3> lossColour_;
+  bool showingLoss_ = false;  // the loss picture is on the texture
+  SourceState state_ = SourceState::kWaiting;
+  std::shared_ptr<FramePool> patternPool_;
+  std::uint64_t patternSequence_ = 0;
+  const Clock& clock_;
+  BoundedQueue<Event> events_;  // state events of the manager; the status comes from status()
+  MjpegTap mjpeg_;              // before manager_: its frame tap, so it outlives the manager's threads
+  bool reportedMjpegFailure_ = false;
+  devices::DeviceManager manager_;
+  std::string name_;
+  bool requested_ = false;
+  bool started_ = false;
+  std::shared_ptr<devices::ManagedVideoStream> stream_;
+  std::unique_ptr<render::StreamTexture> texture_;
+};
+
+Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, const Manifest& show,
+                                                        const Clock& clock) {
+  const DeviceSpec* spec = nullptr;
+  for (const DeviceSpec& d : show.devices) {
+    if (d.name == media.device) spec = &d;
+  }
+  if (!spec || spec->kind != DeviceKind::kCamera) {
+    return fail(Errc::kNotFound, fmt::format("media '{}': no camera '{}' in [devices]", media.name, media.device));
+  }
+  auto provider = providerFor(*spec);
+  if (!provider) return std::unexpected(provider.error());
+  devices::DeviceRequest request;
+  request.name = spec->name;
+  request.kind = devices::DeviceKind::kVideoSource;
+  request.match = deviceMatchFor(*spec);
+  if (spec->width && spec->height) request.options["size"] = fmt::format("{}x{}", *spec->width, *spec->height);
+  if (spec->backend == DeviceBackend::kReplay || spec->backend == DeviceBackend::kSynthetic) {
+    request.options["loop"] = spec->loop ? "true" : "false";
+  }
+  if (!spec->format.empty()) request.options["format"] = spec->format;
+  request.controls.mirror = spec->mirror;
+  if (spec->backend == DeviceBackend::kSynthetic && !spec->faults.empty()) {
+    std::string faults;
+    for (const SyntheticFault& f : spec->faults) {
+      if (!faults.empty()) faults += ',';
+      switch (f.kind) {
+        case SyntheticFault::Kind::kUnplug: faults += fmt::format("unplug@{}", f.at.count()); break;
+        case SyntheticFault::Kind::kSignalLost:
+          faults += fmt::format("signal_lost@{}+{}", f.at.count(), f.duration.count());
+          break;
+        case SyntheticFault::Kind::kStall:
+          faults += fmt::format("stall@{}+{}", f.at.count(), f.duration.count());
+          break;
+        case SyntheticFault::Kind::kCorrupt: faults += fmt::format("corrupt@{}", f.at.count()); break;
+      }
+    }
+    request.options["faults"] = faults;
+  }
+  return std::make_unique<CameraStream>(media, std::move(*provider), std::move(request), clock);
+}
+
+Result<std::unique_ptr<devices::DialBox>> makeDialBoxFromSpec(const DeviceSpec& spec, const Clock& clock) {
+  auto provider = providerFor(spec);
+  if (!provider) return std::unexpected(provider.error());
+  devices::DeviceRequest request;
+  request.name = spec.name;
+  request.kind = devices::DeviceKind::kDialBox;
+  request.match = deviceMatchFor(spec);
+  request.options["loop"] = spec.loop ? "true" : "false";
+  std::error_code ec;
+  if (spec.backend == DeviceBackend::kReplay && std::filesystem::is_regular_file(spec.trace, ec)) {
+    // A hid-recorder file of several nodes (a tablet's pad and pen, a keydial's two interfaces):
+    // the box plays the busiest one (its path in the replay is FILE#N).
+    auto recording = sim::readHidRecording(spec.trace);
+    if (!recording) return std::unexpected(recording.error());
+    if (recording->devices.size() > 1) {
+      const auto busiest = std::ranges::max_element(recording->devices, {},
+                                                    [](const sim::HidRecordedDevice& d) { return d.reports.size(); });
+      request.match.path = fmt::format("{}#{}", spec.trace.string(), busiest->index);
+    }
+  }
+  // The SGI box answers its reset within milliseconds; a retry with nothing on the port must not
+  // hold the frame loop for the backend's default second.
+  if (spec.backend == DeviceBackend::kSerial) request.options["reset_timeout_ms"] = "200";
+  return makeMatchedDialBox(std::move(*provider), std::move(request), clock);
+}
+
+}  // namespace
+
+devices::DeviceMatch deviceMatchFor(const DeviceSpec& spec) {
+  devices::DeviceMatch m;
+  m.backend = std::string(deviceBackendName(spec.backend));
+  m.vendor = spec.match.vendor;
+  m.product = spec.match.product;
+  m.name = spec.match.name;
+  m.serial = spec.match.serial;
+  // A replayed device's path is its recording's; the manifest's path names the real device.
+  if (spec.backend != DeviceBackend::kReplay) m.path = spec.match.path;
+  return m;
+}
+
+Result<std::unique_ptr<devices::DeviceProvider>> providerFor(const DeviceSpec& spec) {
+  switch (spec.backend) {
+    case DeviceBackend::kHid: return std::make_unique<devices::HidProvider>();
+    case DeviceBackend::kV4l2: return std::make_unique<devices::V4l2Provider>();
+    case DeviceBackend::kLibcamera: return std::make_unique<devices::LibcameraProvider>();
+    case DeviceBackend::kSynthetic: return std::make_unique<sim::SyntheticProvider>();
+    // The SGI box on the manifest's port (and any USB serial adapter; the match picks the port).
+    case DeviceBackend::kSerial: return std::make_unique<devices::SerialProvider>(std::vector{spec.match.path});
+    case DeviceBackend::kReplay: {
+      auto replay = std::make_unique<sim::ReplayProvider>(matroskaTraceReaderFactory());
+      std::error_code ec;
+      auto added = std::filesystem::is_directory(spec.trace, ec) ? replay->addTrace(spec.trace)
+                                                                 : replay->addHidRecording(spec.trace);
+      if (!added) return std::unexpected(added.error());
+      return replay;
+    }
+  }
+  return fail(Errc::kUnsupported, fmt::format("no {} backend", deviceBackendName(spec.backend)));
+}
+
+std::unique_ptr<devices::DialBox> makeMatchedDialBox(std::unique_ptr<devices::DeviceProvider> provider,
+                                                     devices::DeviceRequest request, const Clock& clock) {
+  return std::make_unique<MatchedDialBox>(std::move(provider), std::move(request), clock);
+}
+
+void setScriptVcrOptions(ScriptPlayerOptions& options, const Manifest& show, const Clock& clock) {
+  options.manualClock = clock.isManual();
+  for (const DeviceSpec& d : show.devices) {
+    if (d.kind != DeviceKind::kCamera) continue;
+    MediaSpec media;
+    media.name = "the script's camera";
+    media.kind = MediaKind::kCamera;
+    media.device = d.name;
+    options.camera = [media, &show, &clock]() { return makeCameraStream(media, show, clock); };
+    return;
+  }
+  options.camera = nullptr;
+}
+
+void registerShowFactories() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    setDialBoxFactory(DeviceBackend::kHid, makeDialBoxFromSpec);
+    setDialBoxFactory(DeviceBackend::kReplay, makeDialBoxFromSpec);
+    setDialBoxFactory(DeviceBackend::kSerial, makeDialBoxFromSpec);
+    setStreamFactory(MediaKind::kMovie, makeMovieStream);
+    setStreamFactory(MediaKind::kCamera, makeCameraStream);
+    setItemFactory(EntryKind::kMovie, makeMovieItem);
+  });
+}
+
+std::optional<std::thread::id> mjpegDecodeThread(const TextureStream& stream) {
+  const auto* camera = dynamic_cast<const CameraStream*>(&stream);
+  return camera ? camera->mjpegDecodeThread() : std::nullopt;
+}
+
+}  // namespace basalt::kiosk

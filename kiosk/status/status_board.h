@@ -1,0 +1,212 @@
+#pragma once
+
+/// \file
+/// \brief What the status and control server reports and how it reaches the frame loop: frame
+/// figures published every frame (without allocating), the show's, devices' and streams' state
+/// published when they change, a ring of recent log records, and the queues that carry control
+/// requests and snapshot requests to the frame loop.
+
+#include <array>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kiosk/lock/lock_figures.h"
+#include "kiosk/policy/schedule.h"
+#include "runtime/bounded_queue.h"
+#include "runtime/clock.h"
+#include "runtime/image.h"
+#include "runtime/log.h"
+#include "runtime/show/show.h"
+
+namespace basalt::kiosk {
+
+/// \brief One device as the operator sees it.
+struct DeviceStatus {
+  std::string name;
+  std::string kind;     ///< "dial_box", "camera"
+  std::string backend;  ///< "hid", "synthetic", ...
+  std::string state;    ///< "live", "absent", "lost", ...
+  std::string message;  ///< why it is not live, or what it is
+  WallTime since{};
+};
+
+/// \brief One stream (movie, camera texture) as the operator sees it.
+struct StreamStatus {
+  std::string name;
+  std::string kind;
+  std::string state;  ///< "playing", "absent", ...
+  std::string message;
+  WallTime since{};
+};
+
+/// \brief The show's state, published when it changes.
+struct ShowStatus {
+  std::string name;
+  std::string manifest;   ///< path, or "" for the built-in default show
+  std::string output;     ///< Output::describe()
+  bool open = true;       ///< within opening hours
+  std::string mode;       ///< "closed", "attract", "active"
+  std::string display;    ///< "on", "black", "off"
+  std::string item;       ///< the item's name, "" when none
+  std::size_t index = 0;  ///< 1-based place in its list, 0 when none
+  std::size_t count = 0;
+  std::string description;                     ///< KioskPolicy::describe()
+  std::optional<WallTime> nextScheduleChange;  ///< filled by StatusBoard::snapshot()
+  /// The show's opening hours (immutable, shared), so that the server works out the next change
+  /// on its own thread rather than the frame loop's.
+  std::shared_ptr<const Schedule> schedule;
+};
+
+/// \brief Figures derived from the recent frames.
+struct FrameFigures {
+  std::int64_t frames = 0;
+  std::int64_t lateFrames = 0;      ///< a present more than 1.5 frame periods after the previous
+  std::int64_t missedAtReload = 0;  ///< late frames in the three frames after a reload swap
+  std::uint64_t inputDropped = 0;   ///< input events lost to a full queue
+  /// Display refreshes that got no new frame: a present that came k frame periods after the
+  /// previous one dropped k - 1 frames (the screen showed the old picture meanwhile).
+  std::int64_t droppedFrames = 0;
+  double framesPerSecond = 0;                                                 ///< over the recent window
+  double intervalP50 = 0, intervalP90 = 0, intervalP99 = 0, intervalMax = 0;  ///< seconds, present to present
+  double workP50 = 0, workP90 = 0, workP99 = 0, workMax = 0;  ///< seconds of the loop's own work per frame
+  double workMean = 0;                                        ///< seconds, over the window
+  double cpuMean = 0;          ///< seconds of the loop thread's CPU time per frame, over the window
+  double longestAtReload = 0;  ///< seconds: the longest present-to-present in the frames after a reload
+  std::size_t window = 0;      ///< frames the percentiles are over
+};
+
+/// \brief Everything the server reports, copied at one moment.
+struct StatusSnapshot {
+  WallTime now{};
+  WallTime startedAt{};
+  ShowStatus show;
+  FrameFigures frames;
+  std::vector<DeviceStatus> devices;
+  std::vector<StreamStatus> streams;
+  std::int64_t reloads = 0;
+  std::int64_t reloadFailures = 0;
+  std::string lastReload;               ///< the last reload's outcome
+  std::vector<log::Record> logTail;     ///< recent records, oldest first
+  std::vector<log::Record> lastErrors;  ///< recent warnings and errors
+  std::uint64_t errorsLogged = 0;
+  runtime::PerformanceMeter performance;  ///< LAVA's meter, as last sampled (updates == 0: not yet)
+  std::optional<FrameLockFigures> lock;   ///< a frame-locked node's figures ([lock]); none otherwise
+};
+
+/// \brief A request from the control server to the frame loop, answered through `reply`.
+enum class ControlKind : std::uint8_t { kNext, kPrevious, kReload, kRunCommand, kRestartDevice, kCalibrate };
+
+struct ControlReply {
+  std::mutex mutex;
+  std::condition_variable done;
+  bool answered = false;  // guarded by mutex
+  int status = 0;         // HTTP-like: 200, 202, 400, 404, 409, 501; guarded by mutex
+  std::string message;    // guarded by mutex
+  /// \brief Sets the answer and wakes the waiter (the frame loop calls this).
+  void answer(int httpStatus, std::string text);
+  /// \brief Waits up to `timeout` for the answer; false on time-out.
+  bool wait(std::chrono::milliseconds timeout);
+};
+
+struct ControlRequest {
+  ControlKind kind = ControlKind::kNext;
+  std::string argument;  ///< the command, the device's name, or calibration statements
+  std::string view;      ///< kCalibrate: the facet view ("" = the first)
+  bool save = false;     ///< kCalibrate: write the calibration back to the cave file
+  std::shared_ptr<ControlReply> reply;
+};
+
+/// \brief A request for the frame on screen, filled by the frame loop after it draws.
+struct SnapshotRequest {
+  std::mutex mutex;
+  std::condition_variable done;
+  bool answered = false;  // guarded by mutex
+  bool ok = false;        // guarded by mutex
+  Image image;            // guarded by mutex
+  std::string error;      // guarded by mutex
+  void answer(bool success, Image picture, std::string why);
+  bool wait(std::chrono::milliseconds timeout);
+};
+
+/// \brief The meeting point of the frame loop and the status server.
+///
+/// Threading: record*/publish*/set* come from the frame loop's thread; snapshot() and the
+/// queues from any thread. `mutex_` guards the published state; the frame figures are plain
+/// fixed-size arrays written under it, so publishing a frame never allocates.
+class StatusBoard {
+ public:
+  /// \brief `logCapacity` records are kept for the log tail.
+  StatusBoard(WallTime startedAt, double nominalFps, std::size_t logCapacity = 200);
+  ~StatusBoard();
+  StatusBoard(const StatusBoard&) = delete;
+  StatusBoard& operator=(const StatusBoard&) = delete;
+
+  // ---- frame loop ----
+  /// \brief One frame (numbered as the frame loop numbers them, for reload accounting): seconds
+  /// of work, seconds since the previous present.
+  void recordFrame(std::int64_t frame, double workSeconds, double intervalSeconds, double cpuSeconds = 0,
+                   std::uint64_t inputDropped = 0);
+  void setNominalFps(double fps);
+  /// \brief The frame in which a reloaded show took over.
+  void noteReloadApplied(std::int64_t frame);
+  void noteReload(bool ok, std::string outcome);
+  void publishShow(ShowStatus status);
+  void publishDevices(std::vector<DeviceStatus> devices);
+  void publishStreams(std::vector<StreamStatus> streams);
+  /// \brief LAVA's performance meter (Show::performance()), after it took a new sample.
+  void publishPerformance(const runtime::PerformanceMeter& meter);
+  /// \brief A frame-locked node's figures (kiosk/lock/frame_lock.h).
+  void publishLock(const FrameLockFigures& figures);
+
+  // ---- any thread ----
+  [[nodiscard]] StatusSnapshot snapshot(WallTime now) const;
+  [[nodiscard]] FrameFigures frameFigures() const;
+  BoundedQueue<ControlRequest>& controls() { return controls_; }
+  BoundedQueue<std::shared_ptr<SnapshotRequest>>& snapshotRequests() { return snapshots_; }
+  /// \brief The show's Clock, whose calendar time the schedule is read in (any thread reads it).
+  void setShowClock(const Clock& clock) { showClock_ = &clock; }
+  /// \brief Set by the run to wake the frame loop when a request arrives.
+  void setWake(std::function<void()> wake);
+  void wake() const;
+
+ private:
+  class CountingSink;
+  static constexpr std::size_t kWindow = 600;  // frames the percentiles are computed over
+
+  mutable std::mutex mutex_;
+  WallTime startedAt_;
+  double nominalFps_;                       // guarded by mutex_
+  std::array<float, kWindow> intervals_{};  // seconds; guarded by mutex_
+  std::array<float, kWindow> work_{};       // seconds; guarded by mutex_
+  std::array<float, kWindow> cpu_{};        // seconds; guarded by mutex_
+  std::size_t next_ = 0;                    // guarded by mutex_
+  std::size_t filled_ = 0;                  // guarded by mutex_
+  std::int64_t frames_ = 0;                 // guarded by mutex_
+  std::int64_t late_ = 0;                   // guarded by mutex_
+  std::int64_t reloadFrame_ = -100;         // guarded by mutex_
+  std::int64_t missedAtReload_ = 0;         // guarded by mutex_
+  double longestAtReload_ = 0;              // guarded by mutex_
+  std::uint64_t inputDropped_ = 0;          // guarded by mutex_
+  std::int64_t droppedFrames_ = 0;          // guarded by mutex_
+  runtime::PerformanceMeter performance_;   // guarded by mutex_
+  std::optional<FrameLockFigures> lock_;    // guarded by mutex_
+  ShowStatus show_;                         // guarded by mutex_
+  std::vector<DeviceStatus> devices_;       // guarded by mutex_
+  std::vector<StreamStatus> streams_;       // guarded by mutex_
+  std::int64_t reloads_ = 0;                // guarded by mutex_
+  std::int64_t reloadFailures_ = 0;         // guarded by mutex_
+  std::string lastReload_;                  // guarded by mutex_
+  std::function<void()> wake_;              // set before the server starts
+  const Clock* showClock_ = nullptr;        // set before the server starts
+  std::shared_ptr<log::RingSink> ring_;
+  std::shared_ptr<CountingSink> counter_;
+  BoundedQueue<ControlRequest> controls_{16};
+  BoundedQueue<std::shared_ptr<SnapshotRequest>> snapshots_{4};
+};
+
+}  // namespace basalt::kiosk

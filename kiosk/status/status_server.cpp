@@ -1,0 +1,314 @@
+// The status and control server on cpp-httplib (a maintained HTTP/1.1 library; used here and
+// nowhere else).
+
+#include "kiosk/status/status_server.h"
+
+#include <httplib.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <fmt/std.h>
+
+#include "media/image_io.h"
+#include "runtime/log.h"
+
+namespace basalt::kiosk {
+
+BASALT_LOG_CATEGORY(Status, "kiosk");
+
+namespace {
+
+constexpr auto kAnswerWait = std::chrono::seconds(3);
+
+std::string trim(std::string s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
+  std::size_t start = 0;
+  while (start < s.size() && std::isspace(static_cast<unsigned char>(s[start]))) ++start;
+  return s.substr(start);
+}
+
+/// Compares in a time that does not depend on where the strings differ.
+bool sameSecret(std::string_view expected, std::string_view given) {
+  if (expected.empty() || expected.size() != given.size()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < expected.size(); ++i) diff |= static_cast<unsigned char>(expected[i] ^ given[i]);
+  return diff == 0;
+}
+
+void replyJson(httplib::Response& res, int status, bool ok, std::string_view message) {
+  res.status = status;
+  res.set_content(fmt::format("{{\"ok\": {}, \"status\": {}, \"message\": {}}}\n", ok ? "true" : "false", status,
+                              jsonString(message)),
+                  "application/json");
+}
+
+/// The server's threads run at a lower priority than the frame loop (nice 10), so that answering
+/// requests takes CPU time from the show only when there is some to spare.
+void yieldToTheShow() {
+  thread_local bool done = false;
+  if (done) return;
+  done = true;
+  ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+}
+
+}  // namespace
+
+/// Token buckets per client address: `rate` requests a second, bursts of twice that.
+class StatusServer::Limiter {
+ public:
+  explicit Limiter(double rate) : rate_(rate), burst_(std::max(2.0, rate * 2)) {}
+  bool allow(const std::string& client) {
+    const Nanos now = clock_.now();
+    std::lock_guard lock(mutex_);
+    auto it = buckets_.find(client);
+    if (it == buckets_.end()) {
+      if (buckets_.size() >= 256) buckets_.clear();  // bounded memory, whatever the clients
+      it = buckets_.emplace(client, Bucket{burst_, now}).first;
+    }
+    Bucket& b = it->second;
+    b.tokens = std::min(burst_, b.tokens + toSeconds(now - b.last) * rate_);
+    b.last = now;
+    if (b.tokens < 1) return false;
+    b.tokens -= 1;
+    return true;
+  }
+
+ private:
+  struct Bucket {
+    double tokens;
+    Nanos last;
+  };
+  double rate_;
+  double burst_;
+  SystemClock clock_;
+  std::mutex mutex_;
+  std::map<std::string, Bucket> buckets_;  // guarded by mutex_
+};
+
+StatusServer::StatusServer(const StatusSpec& spec, StatusBoard& board, std::string token)
+    : spec_(spec),
+      board_(board),
+      token_(std::move(token)),
+      server_(std::make_unique<httplib::Server>()),
+      limiter_(std::make_unique<Limiter>(spec.requestsPerSecond)) {}
+
+StatusServer::~StatusServer() {
+  server_->stop();
+  if (thread_.joinable()) thread_.join();
+}
+
+std::string StatusServer::url() const {
+  const bool v6 = spec_.host.find(':') != std::string::npos;
+  return fmt::format("http://{}{}{}:{}/", v6 ? "[" : "", spec_.host, v6 ? "]" : "", port_);
+}
+
+ServerCounters StatusServer::counters() const {
+  return {requests_.load(), rejectedRate_.load(), rejectedAuth_.load(), rejectedSize_.load()};
+}
+
+Result<std::unique_ptr<StatusServer>> StatusServer::start(const StatusSpec& spec, StatusBoard& board) {
+  std::string token = spec.token;
+  if (token.empty() && !spec.tokenFile.empty()) {
+    std::ifstream in(spec.tokenFile);
+    if (in) {
+      std::ostringstream text;
+      text << in.rdbuf();
+      token = trim(text.str());
+    }
+    if (token.size() < 16) {
+      log::warn(kLogStatus, "the token file {} is missing or shorter than 16 characters; controls are off",
+                spec.tokenFile);
+      token.clear();
+    }
+  }
+  auto server = std::unique_ptr<StatusServer>(new StatusServer(spec, board, std::move(token)));
+  server->routes();
+  httplib::Server& http = *server->server_;
+  http.new_task_queue = [] { return new httplib::ThreadPool(2); };
+  http.set_payload_max_length(spec.maxRequestBytes);
+  http.set_read_timeout(5, 0);
+  http.set_write_timeout(5, 0);
+  http.set_keep_alive_max_count(20);
+  http.set_keep_alive_timeout(5);
+  int port = spec.port;
+  if (port == 0) {
+    port = http.bind_to_any_port(spec.host);
+  } else if (!http.bind_to_port(spec.host, port)) {
+    port = -1;
+  }
+  if (port <= 0) {
+    return fail(Errc::kUnavailable, fmt::format("the status server cannot listen on {}:{} ({}); another program may "
+                                                "use the port: change [status] listen in show.toml",
+                                                spec.host, spec.port, std::strerror(errno)));
+  }
+  server->port_ = static_cast<std::uint16_t>(port);
+  server->thread_ = std::thread([s = server.get()] {
+    yieldToTheShow();
+    s->server_->listen_after_bind();
+  });
+  log::info(kLogStatus, "status server on {} (controls {})", server->url(),
+            server->controlsEnabled() ? "on, with the token" : "off: no token");
+  return server;
+}
+
+void StatusServer::routes() {
+  httplib::Server& http = *server_;
+  http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    yieldToTheShow();
+    requests_.fetch_add(1, std::memory_order_relaxed);
+    if (!limiter_->allow(req.remote_addr)) {
+      rejectedRate_.fetch_add(1, std::memory_order_relaxed);
+      res.set_header("Retry-After", "1");
+      replyJson(res, 429, false, fmt::format("too many requests: at most {} a second", spec_.requestsPerSecond));
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+  http.set_error_handler([this](const httplib::Request& req, httplib::Response& res) {
+    if (res.status == 413) rejectedSize_.fetch_add(1, std::memory_order_relaxed);
+    if (!res.body.empty()) return;
+    switch (res.status) {
+      case 404: replyJson(res, 404, false, fmt::format("no such page: {}; see / for the status page", req.path)); break;
+      case 413:
+        replyJson(res, 413, false, fmt::format("request too large: at most {} bytes", spec_.maxRequestBytes));
+        break;
+      case 400: replyJson(res, 400, false, "malformed request"); break;
+      case 414: replyJson(res, 414, false, "request line too long"); break;
+      default: replyJson(res, res.status, false, fmt::format("HTTP status {}", res.status)); break;
+    }
+  });
+
+  const auto now = [] { return SystemClock().wallNow(); };
+  http.Get("/health", [this, now](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(healthJson(board_.snapshot(now())), "application/json");
+  });
+  http.Get("/metrics", [this, now](const httplib::Request&, httplib::Response& res) {
+    res.set_content(metricsText(board_.snapshot(now()), counters()), "text/plain; version=0.0.4; charset=utf-8");
+  });
+  http.Get("/", [](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(std::string(statusPageHtml()), "text/html; charset=utf-8");
+  });
+  http.Get("/snapshot.png", [this](const httplib::Request& req, httplib::Response& res) {
+    std::uint32_t width = 0;
+    if (req.has_param("w")) {
+      const std::string w = req.get_param_value("w");
+      unsigned value = 0;
+      const auto [end, ec] = std::from_chars(w.data(), w.data() + w.size(), value);
+      if (ec != std::errc{} || end != w.data() + w.size() || value == 0 || value > 16384) {
+        replyJson(res, 400, false, "w must be a width in pixels, 1 to 16384");
+        return;
+      }
+      width = value;
+    }
+    auto request = std::make_shared<SnapshotRequest>();
+    if (!board_.snapshotRequests().push(request)) {
+      replyJson(res, 503, false, "too many snapshots asked at once; try again");
+      return;
+    }
+    board_.wake();
+    if (!request->wait(kAnswerWait)) {
+      replyJson(res, 503, false, "the frame loop did not draw a frame within 3 s; it may be hung");
+      return;
+    }
+    std::lock_guard lock(request->mutex);
+    if (!request->ok) {
+      replyJson(res, 500, false, request->error);
+      return;
+    }
+    auto png = media::encodePng(width ? scaleDown(request->image, width) : request->image);
+    if (!png) {
+      replyJson(res, 500, false, png.error().describe());
+      return;
+    }
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(reinterpret_cast<const char*>(png->data()), png->size(), "image/png");
+  });
+
+  const auto control = [this](ControlKind kind, bool needsArgument) {
+    return [this, kind, needsArgument](const httplib::Request& req, httplib::Response& res) {
+      if (token_.empty()) {
+        rejectedAuth_.fetch_add(1, std::memory_order_relaxed);
+        replyJson(res, 403, false, "controls are off: this show has no token (set status.token_file in show.toml)");
+        return;
+      }
+      const std::string auth = req.get_header_value("Authorization");
+      if (auth.empty()) {
+        rejectedAuth_.fetch_add(1, std::memory_order_relaxed);
+        res.set_header("WWW-Authenticate", "Bearer realm=\"basalt\"");
+        replyJson(res, 401, false, "controls need the header 'Authorization: Bearer TOKEN'");
+        return;
+      }
+      if (!auth.starts_with("Bearer ") || !sameSecret(token_, std::string_view(auth).substr(7))) {
+        rejectedAuth_.fetch_add(1, std::memory_order_relaxed);
+        replyJson(res, 403, false, "wrong token");
+        return;
+      }
+      ControlRequest request;
+      request.kind = kind;
+      request.argument = req.has_param("device") ? req.get_param_value("device") : trim(req.body);
+      request.view = req.has_param("view") ? req.get_param_value("view") : std::string();
+      request.save = req.has_param("save") && req.get_param_value("save") != "0";
+      // Calibration statements may come one per line, as in a cave file.
+      if (kind == ControlKind::kCalibrate) std::replace(request.argument.begin(), request.argument.end(), '\n', ';');
+      if (needsArgument && request.argument.empty()) {
+        replyJson(res, 400, false,
+                  kind == ControlKind::kRunCommand ? "the body must be one LAVA script command"
+                                                   : "name the device: ?device=NAME or the body");
+        return;
+      }
+      if (request.argument.find('\n') != std::string::npos || request.argument.find('\0') != std::string::npos) {
+        replyJson(res, 400, false, "one line only");
+        return;
+      }
+      request.reply = std::make_shared<ControlReply>();
+      auto reply = request.reply;
+      if (!board_.controls().push(std::move(request))) {
+        replyJson(res, 503, false, "too many controls waiting; try again");
+        return;
+      }
+      board_.wake();
+      if (!reply->wait(kAnswerWait)) {
+        replyJson(res, 503, false, "the frame loop did not answer within 3 s; it may be hung");
+        return;
+      }
+      std::lock_guard lock(reply->mutex);
+      log::info(kLogStatus, "control {} from {}: {}", req.path, req.remote_addr, reply->message);
+      replyJson(res, reply->status, reply->status < 300, reply->message);
+    };
+  };
+  http.Post("/control/next", control(ControlKind::kNext, false));
+  http.Post("/control/previous", control(ControlKind::kPrevious, false));
+  http.Post("/control/reload", control(ControlKind::kReload, false));
+  http.Post("/control/command", control(ControlKind::kRunCommand, true));
+  http.Post("/control/restart-device", control(ControlKind::kRestartDevice, true));
+  http.Post("/control/calibrate", control(ControlKind::kCalibrate, false));
+
+  // Wrong methods on known paths say which method they take.
+  const auto methodNotAllowed = [](std::string_view allowed) {
+    return [allowed](const httplib::Request&, httplib::Response& res) {
+      res.set_header("Allow", std::string(allowed));
+      replyJson(res, 405, false, fmt::format("use {}", allowed));
+    };
+  };
+  for (const char* path : {"/health", "/metrics", "/snapshot.png", "/"}) {
+    http.Post(path, methodNotAllowed("GET"));
+    http.Put(path, methodNotAllowed("GET"));
+    http.Delete(path, methodNotAllowed("GET"));
+  }
+  for (const char* path : {"/control/next", "/control/previous", "/control/reload", "/control/command",
+                           "/control/restart-device", "/control/calibrate"}) {
+    http.Get(path, methodNotAllowed("POST"));
+  }
+}
+
+}  // namespace basalt::kiosk
