@@ -622,7 +622,11 @@ int runShow(const RunOptions& options) {
     auto started = StatusServer::start(manifest.status, board);
     if (started) {
       server = std::move(*started);
-      fmt::print("basalt: status server: {}\n", server->url());
+      if (server->listening()) {
+        fmt::print("basalt: status server: {}\n", server->url());
+      } else {
+        fmt::print("basalt: status server: not up yet: {}; trying again\n", server->notUpBecause());
+      }
       std::fflush(stdout);
     } else {
       // The show matters more than its status page.

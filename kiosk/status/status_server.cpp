@@ -5,10 +5,13 @@
 
 #include <httplib.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -101,13 +104,93 @@ StatusServer::StatusServer(const StatusSpec& spec, StatusBoard& board, std::stri
       limiter_(std::make_unique<Limiter>(spec.requestsPerSecond)) {}
 
 StatusServer::~StatusServer() {
-  server_->stop();
-  if (thread_.joinable()) thread_.join();
+  {
+    std::lock_guard lock(bindMutex_);
+    stopping_ = true;
+  }
+  stopWake_.notify_all();
+  if (!thread_.joinable()) return;
+  // Once bound, the thread goes on to serve: stop() ends that, but only once it runs.
+  while (bound_.load(std::memory_order_acquire) && !served_.load(std::memory_order_acquire)) {
+    if (server_->is_running()) {
+      server_->stop();
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  thread_.join();
+}
+
+std::string StatusServer::notUpBecause() const {
+  std::lock_guard lock(bindMutex_);
+  return notUpBecause_;
+}
+
+bool StatusServer::bind() {
+  httplib::Server& http = *server_;
+  errno = 0;
+  int port = spec_.port;
+  if (port == 0) {
+    port = http.bind_to_any_port(spec_.host);
+  } else if (!http.bind_to_port(spec_.host, port)) {
+    port = -1;
+  }
+  const int error = errno;
+  if (port > 0) {
+    port_.store(static_cast<std::uint16_t>(port), std::memory_order_release);
+    std::lock_guard lock(bindMutex_);
+    notUpBecause_.clear();
+    return true;
+  }
+  std::lock_guard lock(bindMutex_);
+  if (error == EADDRINUSE) {
+    notUpBecause_ = fmt::format(
+        "port {} on {} is taken: another Basalt may be running (systemctl status basalt; ss -ltnp 'sport = :{}'), "
+        "or another program uses it (change [status] listen in show.toml)",
+        spec_.port, spec_.host, spec_.port);
+  } else {
+    notUpBecause_ = fmt::format("cannot listen on {}:{}: {}; check [status] listen in show.toml", spec_.host,
+                                spec_.port, error != 0 ? std::strerror(error) : "no such address");
+  }
+  return false;
+}
+
+void StatusServer::serve() {
+  yieldToTheShow();
+  if (!bound_.load(std::memory_order_acquire)) {
+    auto wait = std::chrono::seconds(1);
+    const auto began = std::chrono::steady_clock::now();
+    int tries = 1;
+    for (;;) {
+      {
+        std::unique_lock lock(bindMutex_);
+        if (stopWake_.wait_for(lock, wait, [this] { return stopping_; })) break;
+      }
+      ++tries;
+      if (bind()) {
+        std::lock_guard lock(bindMutex_);
+        if (stopping_) break;  // stopped while binding: the process is on its way out
+        bound_.store(true, std::memory_order_release);
+        const auto after = std::chrono::duration_cast<std::chrono::seconds>(std::chrono::steady_clock::now() - began);
+        log::info(kLogStatus, "status server on {} (the port was free after {} s and {} tries; controls {})", url(),
+                  after.count(), tries, controlsEnabled() ? "on, with the token" : "off: no token");
+        break;
+      }
+      // Said once more when the back-off reaches its longest, so that a long wait does not
+      // fill the log.
+      if (wait == std::chrono::seconds(16)) {
+        log::warn(kLogStatus, "the status server is still not up: {}; trying every 30 s", notUpBecause());
+      }
+      wait = std::min<std::chrono::seconds>(wait * 2, std::chrono::seconds(30));
+    }
+  }
+  if (bound_.load(std::memory_order_acquire)) server_->listen_after_bind();
+  served_.store(true, std::memory_order_release);
 }
 
 std::string StatusServer::url() const {
   const bool v6 = spec_.host.find(':') != std::string::npos;
-  return fmt::format("http://{}{}{}:{}/", v6 ? "[" : "", spec_.host, v6 ? "]" : "", port_);
+  return fmt::format("http://{}{}{}:{}/", v6 ? "[" : "", spec_.host, v6 ? "]" : "", port());
 }
 
 ServerCounters StatusServer::counters() const {
@@ -138,24 +221,26 @@ Result<std::unique_ptr<StatusServer>> StatusServer::start(const StatusSpec& spec
   http.set_write_timeout(5, 0);
   http.set_keep_alive_max_count(20);
   http.set_keep_alive_timeout(5);
-  int port = spec.port;
-  if (port == 0) {
-    port = http.bind_to_any_port(spec.host);
-  } else if (!http.bind_to_port(spec.host, port)) {
-    port = -1;
-  }
-  if (port <= 0) {
-    return fail(Errc::kUnavailable, fmt::format("the status server cannot listen on {}:{} ({}); another program may "
-                                                "use the port: change [status] listen in show.toml",
-                                                spec.host, spec.port, std::strerror(errno)));
-  }
-  server->port_ = static_cast<std::uint16_t>(port);
-  server->thread_ = std::thread([s = server.get()] {
-    yieldToTheShow();
-    s->server_->listen_after_bind();
+  // httplib's default sets SO_REUSEPORT, with which a second process binds the same port and
+  // the kernel hands it half the connections. SO_REUSEADDR alone lets a restart bind at once
+  // past connections in TIME_WAIT, and a port in use stays refused.
+  http.set_socket_options([](int socket) {
+    const int yes = 1;
+    ::setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
   });
-  log::info(kLogStatus, "status server on {} (controls {})", server->url(),
-            server->controlsEnabled() ? "on, with the token" : "off: no token");
+  server->port_.store(spec.port, std::memory_order_release);
+  if (server->bind()) {
+    server->bound_.store(true, std::memory_order_release);
+    log::info(kLogStatus, "status server on {} (controls {})", server->url(),
+              server->controlsEnabled() ? "on, with the token" : "off: no token");
+  } else {
+    // The show matters more than its status page: it plays on while the server waits.
+    log::error(kLogStatus,
+               "the status server is not up yet: {}; the show plays on, and the server tries again in "
+               "1 s, then less often",
+               server->notUpBecause());
+  }
+  server->thread_ = std::thread([s = server.get()] { s->serve(); });
   return server;
 }
 

@@ -7,6 +7,7 @@
 // server; a page that stays empty because its script failed.
 
 #include <gtest/gtest.h>
+#include <httplib.h>
 
 #include <signal.h>
 #include <unistd.h>
@@ -306,6 +307,50 @@ TEST(StatusServerWithoutToken, ControlsAreOff) {
   EXPECT_EQ(r.status, 403);
   EXPECT_NE(r.body.find("controls are off"), std::string::npos) << r.body;
   EXPECT_EQ(show->get("/health").status, 200) << "reading needs no token";
+}
+
+// Makes sure a second Basalt beside a running one (one started by hand beside the service) gets
+// none of the first one's requests, says the port is taken, plays on, and takes the port once the
+// first is gone. Example failures: the second binds too (SO_REUSEPORT) and answers half the
+// requests; it exits, and systemd restarts it in a loop; it never tries again.
+TEST(StatusServerSecondProcess, SaysThePortIsTakenAndTakesItLater) {
+  std::string why;
+  if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  const auto firstDir = test::writeShow("status-port-first", showManifest(false));
+  auto first = test::RunningShow::start({(firstDir / "show.toml").string(), "--realtime", "--no-resume"}, {}, why);
+  ASSERT_TRUE(first) << why;
+  const std::string port = std::to_string(first->port());
+  std::string manifest = showManifest(false);
+  manifest.replace(manifest.find("127.0.0.1:0"), 11, "127.0.0.1:" + port);
+  manifest.replace(manifest.find("Status test"), 11, "Second show");
+  const auto secondDir = test::writeShow("status-port-second", manifest);
+  auto second = test::Process::start({(test::binaryDir() / "basalt").string(), "run",
+                                      (secondDir / "show.toml").string(), "--realtime", "--no-resume"});
+  ASSERT_TRUE(second.waitForOutput("basalt: status server: not up yet: ", std::chrono::seconds(30)))
+      << second.outputSoFar();
+  ASSERT_TRUE(second.waitForOutput("first frame on", std::chrono::seconds(30))) << second.outputSoFar();
+  EXPECT_NE(second.outputSoFar().find("port " + port + " on 127.0.0.1 is taken: another Basalt may be running"),
+            std::string::npos)
+      << second.outputSoFar();
+  // Both run; every request is the first show's.
+  for (int i = 0; i < 10; ++i) {
+    const auto h = first->get("/health");
+    ASSERT_EQ(h.status, 200);
+    EXPECT_NE(h.body.find("Status test"), std::string::npos) << "answered by the second show: " << h.body;
+  }
+  EXPECT_EQ(::kill(second.pid(), 0), 0) << "the second show plays on";
+
+  first->process().signal(SIGTERM);
+  (void)first->process().wait(std::chrono::seconds(20));
+  ASSERT_TRUE(second.waitForOutput("status server on http://127.0.0.1:" + port + "/ (the port was free after",
+                                   std::chrono::seconds(10)))
+      << second.outputSoFar();
+  httplib::Client client("127.0.0.1", first->port());
+  const auto h = client.Get("/health");
+  ASSERT_TRUE(h);
+  EXPECT_NE(h->body.find("Second show"), std::string::npos) << h->body;
+  second.signal(SIGTERM);
+  EXPECT_EQ(second.wait(std::chrono::seconds(20)).exitCode, 0);
 }
 
 // ---- Calibrating a facet view -----------------------------------------------------------------
