@@ -15,6 +15,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -51,6 +52,23 @@ void replyJson(httplib::Response& res, int status, bool ok, std::string_view mes
   res.set_content(fmt::format("{{\"ok\": {}, \"status\": {}, \"message\": {}}}\n", ok ? "true" : "false", status,
                               jsonString(message)),
                   "application/json");
+}
+
+/// The request's body. A request with neither Content-Length nor Transfer-Encoding has none (RFC
+/// 9112, section 6.3), as `curl -X POST` sends it; httplib would instead read until the client
+/// closes, and answer 400 when its read time-out came first. So POST handlers take a
+/// ContentReader and read only an announced body; an announced one is read whole, so that its
+/// bytes are not taken for the next request on the connection. Empty when it could not be read:
+/// `res.status` then says why (413, 400) and the error handler words the answer.
+std::optional<std::string> requestBody(const httplib::Request& req, const httplib::ContentReader& reader) {
+  std::string body;
+  if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) return body;
+  const bool read = reader([&body](const char* data, std::size_t length) {
+    body.append(data, length);
+    return true;
+  });
+  if (!read) return std::nullopt;
+  return body;
 }
 
 /// The server's threads run at a lower priority than the frame loop (nice 10), so that answering
@@ -320,7 +338,10 @@ void StatusServer::routes() {
   });
 
   const auto control = [this](ControlKind kind, bool needsArgument) {
-    return [this, kind, needsArgument](const httplib::Request& req, httplib::Response& res) {
+    return [this, kind, needsArgument](const httplib::Request& req, httplib::Response& res,
+                                       const httplib::ContentReader& reader) {
+      const std::optional<std::string> body = requestBody(req, reader);
+      if (!body) return;
       if (token_.empty()) {
         rejectedAuth_.fetch_add(1, std::memory_order_relaxed);
         replyJson(res, 403, false, "controls are off: this show has no token (set status.token_file in show.toml)");
@@ -340,7 +361,15 @@ void StatusServer::routes() {
       }
       ControlRequest request;
       request.kind = kind;
-      request.argument = req.has_param("device") ? req.get_param_value("device") : trim(req.body);
+      // A form (curl -d device=NAME) names the device as the query does.
+      httplib::Params form;
+      if (req.get_header_value("Content-Type").starts_with("application/x-www-form-urlencoded")) {
+        httplib::detail::parse_query_text(*body, form);
+      }
+      const auto device = form.find("device");
+      request.argument = req.has_param("device") ? req.get_param_value("device")
+                         : device != form.end()  ? device->second
+                                                 : trim(*body);
       request.view = req.has_param("view") ? req.get_param_value("view") : std::string();
       request.save = req.has_param("save") && req.get_param_value("save") != "0";
       // Calibration statements may come one per line, as in a cave file.
@@ -378,22 +407,43 @@ void StatusServer::routes() {
   http.Post("/control/restart-device", control(ControlKind::kRestartDevice, true));
   http.Post("/control/calibrate", control(ControlKind::kCalibrate, false));
 
-  // Wrong methods on known paths say which method they take.
+  // Wrong methods on known paths say which method they take; unknown paths are 404 whatever the
+  // method. Requests that may carry a body are answered at once when they announce none.
   const auto methodNotAllowed = [](std::string_view allowed) {
     return [allowed](const httplib::Request&, httplib::Response& res) {
       res.set_header("Allow", std::string(allowed));
       replyJson(res, 405, false, fmt::format("use {}", allowed));
     };
   };
+  const auto withBody = [methodNotAllowed](std::string_view allowed) {
+    return [answer = methodNotAllowed(allowed)](const httplib::Request& req, httplib::Response& res,
+                                                const httplib::ContentReader& reader) {
+      if (requestBody(req, reader)) answer(req, res);
+    };
+  };
   for (const char* path : {"/health", "/metrics", "/snapshot.png", "/"}) {
-    http.Post(path, methodNotAllowed("GET"));
-    http.Put(path, methodNotAllowed("GET"));
-    http.Delete(path, methodNotAllowed("GET"));
+    http.Post(path, withBody("GET"));
+    http.Put(path, withBody("GET"));
+    http.Patch(path, withBody("GET"));
+    http.Delete(path, withBody("GET"));
   }
   for (const char* path : {"/control/next", "/control/previous", "/control/reload", "/control/command",
                            "/control/restart-device", "/control/calibrate"}) {
     http.Get(path, methodNotAllowed("POST"));
+    http.Put(path, withBody("POST"));
+    http.Patch(path, withBody("POST"));
+    http.Delete(path, withBody("POST"));
   }
+  const auto noSuchPage = [](const httplib::Request& req, httplib::Response& res,
+                             const httplib::ContentReader& reader) {
+    if (requestBody(req, reader)) {
+      replyJson(res, 404, false, fmt::format("no such page: {}; see / for the status page", req.path));
+    }
+  };
+  http.Post(".*", noSuchPage);
+  http.Put(".*", noSuchPage);
+  http.Patch(".*", noSuchPage);
+  http.Delete(".*", noSuchPage);
 }
 
 }  // namespace basalt::kiosk

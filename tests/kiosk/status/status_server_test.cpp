@@ -22,6 +22,7 @@
 #include "kiosk/status/status_board.h"
 #include "kiosk/status/status_server.h"
 #include "support/process.h"
+#include "support/test_paths.h"
 
 namespace basalt::kiosk {
 namespace {
@@ -81,7 +82,7 @@ int get(std::uint16_t port, const std::string& path, std::string* body = nullptr
 }
 
 /// Sends `bytes` on a fresh connection and returns what comes back within `patience`.
-[[maybe_unused]] std::string raw(std::uint16_t port, const std::string& bytes, std::chrono::milliseconds patience) {
+std::string raw(std::uint16_t port, const std::string& bytes, std::chrono::milliseconds patience) {
   const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   sockaddr_in address{};
   address.sin_family = AF_INET;
@@ -182,6 +183,94 @@ TEST(StatusServerPort, AWaitingServerStopsAtOnce) {
   const auto began = std::chrono::steady_clock::now();
   second->reset();
   EXPECT_LT(std::chrono::steady_clock::now() - began, 500ms);
+}
+
+/// The status line's code ("HTTP/1.1 200 OK" -> 200), or 0.
+int statusOf(const std::string& answer) {
+  return answer.starts_with("HTTP/1.1 ") && answer.size() >= 12 ? std::stoi(answer.substr(9, 3)) : 0;
+}
+
+// Makes sure a POST that announces no body (neither Content-Length nor Transfer-Encoding, as
+// `curl -X POST` sends it) is taken at once as a POST with an empty body, on every path, while
+// the client keeps its connection open. Example failure: 400 "malformed request" after httplib
+// waited five seconds for the client to close.
+TEST(StatusServerPost, APostWithoutABodyIsAPost) {
+  StatusBoard board(WallTime{}, 30);
+  FakeLoop loop(board);
+  auto server = StatusServer::start(spec(0), board);
+  ASSERT_TRUE(server) << server.error().describe();
+  const std::uint16_t port = (*server)->port();
+  const std::string auth = std::string("Authorization: Bearer ") + kToken + "\r\n";
+  const auto began = std::chrono::steady_clock::now();
+  const std::string next = raw(port, "POST /control/next HTTP/1.1\r\nHost: x\r\n" + auth + "\r\n", 3s);
+  EXPECT_EQ(statusOf(next), 200) << next;
+  EXPECT_TRUE(has(next, "did 0 with ''")) << next;
+  EXPECT_LT(std::chrono::steady_clock::now() - began, 1s) << "answered without waiting for a body";
+  EXPECT_EQ(loop.answered(), 1);
+  // The device named in the query, no body.
+  const std::string restart =
+      raw(port, "POST /control/restart-device?device=knob HTTP/1.1\r\nHost: x\r\n" + auth + "\r\n", 3s);
+  EXPECT_EQ(statusOf(restart), 200) << restart;
+  EXPECT_TRUE(has(restart, "with 'knob'")) << restart;
+  // A command needs its body: without one, a clear 400 at once.
+  const std::string command = raw(port, "POST /control/command HTTP/1.1\r\nHost: x\r\n" + auth + "\r\n", 3s);
+  EXPECT_EQ(statusOf(command), 400) << command;
+  EXPECT_TRUE(has(command, "the body must be one LAVA script command")) << command;
+  // Without the token, and on other paths: answered at once too.
+  EXPECT_EQ(statusOf(raw(port, "POST /control/next HTTP/1.1\r\nHost: x\r\n\r\n", 3s)), 401);
+  const std::string health = raw(port, "POST /health HTTP/1.1\r\nHost: x\r\n\r\n", 3s);
+  EXPECT_EQ(statusOf(health), 405) << health;
+  EXPECT_TRUE(has(health, "Allow: GET")) << health;
+  const std::string nowhere = raw(port, "POST /nowhere HTTP/1.1\r\nHost: x\r\n\r\n", 3s);
+  EXPECT_EQ(statusOf(nowhere), 404) << nowhere;
+  EXPECT_TRUE(has(nowhere, "no such page: /nowhere")) << nowhere;
+  EXPECT_EQ(statusOf(raw(port, "DELETE /control/next HTTP/1.1\r\nHost: x\r\n\r\n", 3s)), 405);
+  EXPECT_LT(std::chrono::steady_clock::now() - began, 3s);
+}
+
+// The same with curl itself, the client a technician types: `curl -X POST` with the token, and
+// `curl -d device=NAME` (a form). Example failure: 400 "malformed request".
+TEST(StatusServerPost, CurlPostsWithAndWithoutABody) {
+  if (::access("/usr/bin/curl", X_OK) != 0) GTEST_SKIP() << "curl is not installed (apt-get install curl)";
+  StatusBoard board(WallTime{}, 30);
+  FakeLoop loop(board);
+  auto server = StatusServer::start(spec(0), board);
+  ASSERT_TRUE(server) << server.error().describe();
+  const std::string url = (*server)->url();
+  const std::string bearer = std::string("Authorization: Bearer ") + kToken;
+  const auto next = test::run({"/usr/bin/curl", "-sS", "--max-time", "4", "-w", "\n%{http_code}", "-X", "POST", "-H",
+                               bearer, url + "control/next"});
+  EXPECT_EQ(next.exitCode, 0) << next.output;
+  EXPECT_TRUE(next.output.ends_with("\n200")) << next.output;
+  EXPECT_TRUE(has(next.output, "did 0 with ''")) << next.output;
+  const auto form = test::run({"/usr/bin/curl", "-sS", "--max-time", "4", "-w", "\n%{http_code}", "-H", bearer, "-d",
+                               "device=dials", url + "control/restart-device"});
+  EXPECT_TRUE(form.output.ends_with("\n200")) << form.output;
+  EXPECT_TRUE(has(form.output, "with 'dials'")) << form.output;
+  const auto command = test::run({"/usr/bin/curl", "-sS", "--max-time", "4", "-w", "\n%{http_code}", "-H", bearer,
+                                  "--data-binary", "render.prim_type = wireframe", url + "control/command"});
+  EXPECT_TRUE(command.output.ends_with("\n200")) << command.output;
+  EXPECT_TRUE(has(command.output, "with 'render.prim_type = wireframe'")) << command.output;
+}
+
+// Makes sure a refused POST's body is still read, so that the next request on the same
+// connection is read as a request. Example failure: the body's bytes taken for a request line,
+// and the next GET answered 400.
+TEST(StatusServerPost, ARefusedBodyDoesNotSpoilTheConnection) {
+  StatusBoard board(WallTime{}, 30);
+  auto server = StatusServer::start(spec(0), board);
+  ASSERT_TRUE(server) << server.error().describe();
+  httplib::Client client("127.0.0.1", (*server)->port());
+  client.set_keep_alive(true);
+  client.set_read_timeout(5, 0);
+  const auto refused =
+      client.Post("/control/command", {{"Authorization", "Bearer wrong"}}, "GET /x HTTP/1.1\r\n\r\n", "text/plain");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 403);
+  const auto health = client.Get("/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  EXPECT_EQ((*server)->counters().requests, 2u);
 }
 
 }  // namespace
