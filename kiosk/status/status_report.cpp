@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 namespace basalt::kiosk {
 
@@ -33,6 +35,27 @@ std::string isoTime(WallTime t) {
   return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}Z", y, m, d, rest / 3600, rest / 60 % 60, rest % 60);
 }
 
+/// Insertion-ordered, so that the documents read in the order they are written.
+using Json = nlohmann::ordered_json;
+
+/// `value` rounded to `decimals` places: figures as precise as they are meaningful. NaN and the
+/// infinities stay as they are (and are written as null).
+double rounded(double value, int decimals) {
+  if (!std::isfinite(value)) return value;
+  const double scale = std::pow(10.0, decimals);
+  return std::round(value * scale) / scale;
+}
+
+/// Valid JSON whatever the strings hold: control characters are escaped, and bytes that are
+/// not UTF-8 (a device's name, a log line from a driver) become U+FFFD; NaN is written as null.
+std::string dumpJson(const Json& json, int indent) {
+  return json.dump(indent, ' ', false, Json::error_handler_t::replace);
+}
+
+std::string logLine(const log::Record& r) {
+  return fmt::format("{} {} {}: {}", isoTime(r.wallTime), log::levelName(r.level), r.category, r.message);
+}
+
 std::string promLabel(std::string_view text) {
   std::string out;
   for (const char c : text) {
@@ -50,26 +73,7 @@ std::string promLabel(std::string_view text) {
 
 }  // namespace
 
-std::string jsonString(std::string_view text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
-        } else {
-          out += c;
-        }
-    }
-  }
-  out += '"';
-  return out;
-}
+std::string jsonString(std::string_view text) { return dumpJson(Json(text), -1); }
 
 std::string_view overallState(const StatusSnapshot& s) {
   for (const DeviceStatus& d : s.devices) {
@@ -88,97 +92,112 @@ std::string_view overallState(const StatusSnapshot& s) {
 
 std::string healthJson(const StatusSnapshot& s) {
   const FrameFigures& f = s.frames;
-  std::string out = "{\n";
-  out += fmt::format("  \"state\": {},\n", jsonString(overallState(s)));
-  out += fmt::format("  \"time\": {},\n", jsonString(isoTime(s.now)));
-  out += fmt::format("  \"uptime_seconds\": {:.3f},\n", std::chrono::duration<double>(s.now - s.startedAt).count());
+  Json out;
+  out["state"] = overallState(s);
+  out["time"] = isoTime(s.now);
+  out["uptime_seconds"] = rounded(std::chrono::duration<double>(s.now - s.startedAt).count(), 3);
   const ShowStatus& sh = s.show;
-  out += "  \"show\": {\n";
-  out += fmt::format("    \"name\": {},\n    \"manifest\": {},\n    \"output\": {},\n", jsonString(sh.name),
-                     jsonString(sh.manifest), jsonString(sh.output));
-  out += fmt::format("    \"open\": {},\n    \"mode\": {},\n    \"display\": {},\n", sh.open ? "true" : "false",
-                     jsonString(sh.mode), jsonString(sh.display));
-  out += fmt::format("    \"item\": {},\n    \"index\": {},\n    \"count\": {},\n", jsonString(sh.item), sh.index,
-                     sh.count);
-  out += fmt::format("    \"description\": {},\n", jsonString(sh.description));
-  out += fmt::format("    \"next_schedule_change\": {}\n  }},\n",
-                     sh.nextScheduleChange ? jsonString(isoTime(*sh.nextScheduleChange)) : std::string("null"));
-  out += "  \"frames\": {\n";
-  out += fmt::format("    \"total\": {},\n    \"per_second\": {:.2f},\n", f.frames, f.framesPerSecond);
-  out += fmt::format("    \"frame_time_ms\": {{\"p50\": {:.3f}, \"p90\": {:.3f}, \"p99\": {:.3f}, \"max\": {:.3f}}},\n",
-                     f.intervalP50 * 1e3, f.intervalP90 * 1e3, f.intervalP99 * 1e3, f.intervalMax * 1e3);
-  out += fmt::format("    \"work_ms\": {{\"p50\": {:.3f}, \"p90\": {:.3f}, \"p99\": {:.3f}, \"max\": {:.3f}}},\n",
-                     f.workP50 * 1e3, f.workP90 * 1e3, f.workP99 * 1e3, f.workMax * 1e3);
-  out += fmt::format("    \"window\": {},\n    \"late\": {},\n    \"dropped\": {},\n", f.window, f.lateFrames,
-                     f.droppedFrames);
-  out += fmt::format("    \"missed_at_reload\": {},\n    \"input_events_dropped\": {}\n  }},\n", f.missedAtReload,
-                     f.inputDropped);
+  out["show"] = {{"name", sh.name},
+                 {"manifest", sh.manifest},
+                 {"output", sh.output},
+                 {"open", sh.open},
+                 {"mode", sh.mode},
+                 {"display", sh.display},
+                 {"item", sh.item},
+                 {"index", sh.index},
+                 {"count", sh.count},
+                 {"description", sh.description},
+                 {"next_schedule_change", sh.nextScheduleChange ? Json(isoTime(*sh.nextScheduleChange)) : Json()}};
+  const auto milliseconds = [](double p50, double p90, double p99, double max) {
+    return Json{{"p50", rounded(p50 * 1e3, 3)},
+                {"p90", rounded(p90 * 1e3, 3)},
+                {"p99", rounded(p99 * 1e3, 3)},
+                {"max", rounded(max * 1e3, 3)}};
+  };
+  out["frames"] = {{"total", f.frames},
+                   {"per_second", rounded(f.framesPerSecond, 2)},
+                   {"frame_time_ms", milliseconds(f.intervalP50, f.intervalP90, f.intervalP99, f.intervalMax)},
+                   {"work_ms", milliseconds(f.workP50, f.workP90, f.workP99, f.workMax)},
+                   {"window", f.window},
+                   {"late", f.lateFrames},
+                   {"dropped", f.droppedFrames},
+                   {"missed_at_reload", f.missedAtReload},
+                   {"input_events_dropped", f.inputDropped}};
   // LAVA's performance meter (manual §9): the last sampled frame's counts, rates over the sample.
   const runtime::PerformanceMeter& m = s.performance;
-  out += fmt::format(
-      "  \"performance\": {{\"triangles\": {}, \"lines\": {}, \"points\": {}, \"parts\": {}, \"facets\": {}, "
-      "\"fps\": {:.2f}, \"primitives_per_second\": {:.0f}, \"sample_seconds\": {:.1f}, \"samples\": {}}},\n",
-      m.triangles, m.lines, m.points, m.parts, m.facets, m.framesPerSecond, m.primitivesPerSecond,
-      m.samplePeriodSeconds, m.updates);
+  out["performance"] = {{"triangles", m.triangles},
+                        {"lines", m.lines},
+                        {"points", m.points},
+                        {"parts", m.parts},
+                        {"facets", m.facets},
+                        {"fps", rounded(m.framesPerSecond, 2)},
+                        {"primitives_per_second", rounded(m.primitivesPerSecond, 0)},
+                        {"sample_seconds", rounded(m.samplePeriodSeconds, 1)},
+                        {"samples", m.updates}};
   if (const std::optional<FrameLockFigures>& l = s.lock) {
-    out += fmt::format(
-        "  \"lock\": {{\"role\": {}, \"node\": {}, \"followers\": {}, \"followers_known\": {}, "
-        "\"barrier_timeouts\": {}, \"followers_dropped\": {}, \"followers_rejoined\": {}, \"late_answers\": {}, "
-        "\"barrier_wait_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"leader_present\": {}, \"leader_lost\": {}, "
-        "\"frames_drawn\": {}, \"last_frame\": {}, \"skipped\": {}, \"presents_missed\": {}, \"skew_frames_max\": {}, "
-        "\"clock_offset_us\": {}, \"delay_ms\": {{\"p50\": {:.3f}, \"max\": {:.3f}}}, \"malformed\": {}, "
-        "\"holding\": {}, \"holding_seconds\": {:.1f}, \"held_frame\": {}, \"leader_returned\": {}, "
-        "\"leader_restarts\": {}, "
-        "\"watchdog_pings_holding\": {}, \"programme_changes\": {}, \"commands_applied\": {}, "
-        "\"commands_resent\": {}, \"commands_lost\": {}, \"movie_frames_corrected\": {}, "
-        "\"movie_frames_late\": {}}},\n",
-        jsonString(l->leader ? "leader" : "follower"), jsonString(l->node), l->followers, l->followersKnown,
-        l->barrierTimeouts, l->followersDropped, l->followersRejoined, l->lateAnswers, l->barrierWaitP50Ms,
-        l->barrierWaitMaxMs, l->leaderPresent ? "true" : "false", l->leaderLost, l->framesDrawn, l->lastFrame,
-        l->skipped, l->presentsMissed, l->maxSkewFrames, l->leader ? l->maxClockOffsetUs : l->clockOffsetUs,
-        l->delayP50Ms, l->delayMaxMs, l->malformed, l->holding ? "true" : "false", l->holdingSeconds, l->heldFrame,
-        l->leaderReturned, l->leaderRestarts, l->watchdogPingsHolding, l->programmeChanges, l->commandsApplied,
-        l->commandsResent, l->commandsLost, l->movieFramesCorrected, l->movieFramesLate);
+    out["lock"] = {
+        {"role", l->leader ? "leader" : "follower"},
+        {"node", l->node},
+        {"followers", l->followers},
+        {"followers_known", l->followersKnown},
+        {"barrier_timeouts", l->barrierTimeouts},
+        {"followers_dropped", l->followersDropped},
+        {"followers_rejoined", l->followersRejoined},
+        {"late_answers", l->lateAnswers},
+        {"barrier_wait_ms", {{"p50", rounded(l->barrierWaitP50Ms, 3)}, {"max", rounded(l->barrierWaitMaxMs, 3)}}},
+        {"leader_present", l->leaderPresent},
+        {"leader_lost", l->leaderLost},
+        {"frames_drawn", l->framesDrawn},
+        {"last_frame", l->lastFrame},
+        {"skipped", l->skipped},
+        {"presents_missed", l->presentsMissed},
+        {"skew_frames_max", l->maxSkewFrames},
+        {"clock_offset_us", l->leader ? l->maxClockOffsetUs : l->clockOffsetUs},
+        {"delay_ms", {{"p50", rounded(l->delayP50Ms, 3)}, {"max", rounded(l->delayMaxMs, 3)}}},
+        {"malformed", l->malformed},
+        {"holding", l->holding},
+        {"holding_seconds", rounded(l->holdingSeconds, 1)},
+        {"held_frame", l->heldFrame},
+        {"leader_returned", l->leaderReturned},
+        {"leader_restarts", l->leaderRestarts},
+        {"watchdog_pings_holding", l->watchdogPingsHolding},
+        {"programme_changes", l->programmeChanges},
+        {"commands_applied", l->commandsApplied},
+        {"commands_resent", l->commandsResent},
+        {"commands_lost", l->commandsLost},
+        {"movie_frames_corrected", l->movieFramesCorrected},
+        {"movie_frames_late", l->movieFramesLate}};
   }
-  out += "  \"devices\": [";
-  for (std::size_t i = 0; i < s.devices.size(); ++i) {
-    const DeviceStatus& d = s.devices[i];
-    out += fmt::format(
-        "{}\n    {{\"name\": {}, \"kind\": {}, \"backend\": {}, \"state\": {}, \"since\": {}, \"message\": {}}}",
-        i ? "," : "", jsonString(d.name), jsonString(d.kind), jsonString(d.backend), jsonString(d.state),
-        jsonString(isoTime(d.since)), jsonString(d.message));
+  Json& devices = out["devices"] = Json::array();
+  for (const DeviceStatus& d : s.devices) {
+    devices.push_back({{"name", d.name},
+                       {"kind", d.kind},
+                       {"backend", d.backend},
+                       {"state", d.state},
+                       {"since", isoTime(d.since)},
+                       {"message", d.message}});
   }
-  out += s.devices.empty() ? "],\n" : "\n  ],\n";
-  out += "  \"streams\": [";
-  for (std::size_t i = 0; i < s.streams.size(); ++i) {
-    const StreamStatus& st = s.streams[i];
-    out += fmt::format("{}\n    {{\"name\": {}, \"kind\": {}, \"state\": {}, \"since\": {}, \"message\": {}}}",
-                       i ? "," : "", jsonString(st.name), jsonString(st.kind), jsonString(st.state),
-                       jsonString(isoTime(st.since)), jsonString(st.message));
+  Json& streams = out["streams"] = Json::array();
+  for (const StreamStatus& st : s.streams) {
+    streams.push_back({{"name", st.name},
+                       {"kind", st.kind},
+                       {"state", st.state},
+                       {"since", isoTime(st.since)},
+                       {"message", st.message}});
   }
-  out += s.streams.empty() ? "],\n" : "\n  ],\n";
-  out += fmt::format("  \"reloads\": {{\"total\": {}, \"failed\": {}, \"last\": {}}},\n", s.reloads, s.reloadFailures,
-                     jsonString(s.lastReload));
-  out += fmt::format("  \"errors_logged\": {},\n", s.errorsLogged);
-  out += "  \"last_errors\": [";
-  for (std::size_t i = 0; i < s.lastErrors.size(); ++i) {
-    const log::Record& r = s.lastErrors[i];
-    out += fmt::format("{}\n    {{\"time\": {}, \"level\": {}, \"category\": {}, \"message\": {}}}", i ? "," : "",
-                       jsonString(isoTime(r.wallTime)), jsonString(log::levelName(r.level)), jsonString(r.category),
-                       jsonString(r.message));
+  out["reloads"] = {{"total", s.reloads}, {"failed", s.reloadFailures}, {"last", s.lastReload}};
+  out["errors_logged"] = s.errorsLogged;
+  Json& errors = out["last_errors"] = Json::array();
+  for (const log::Record& r : s.lastErrors) {
+    errors.push_back({{"time", isoTime(r.wallTime)},
+                      {"level", log::levelName(r.level)},
+                      {"category", r.category},
+                      {"message", r.message}});
   }
-  out += s.lastErrors.empty() ? "],\n" : "\n  ],\n";
-  out += "  \"log_tail\": [";
+  Json& tail = out["log_tail"] = Json::array();
   const std::size_t first = s.logTail.size() > 30 ? s.logTail.size() - 30 : 0;
-  for (std::size_t i = first; i < s.logTail.size(); ++i) {
-    const log::Record& r = s.logTail[i];
-    out += fmt::format(
-        "{}\n    {}", i > first ? "," : "",
-        jsonString(fmt::format("{} {} {}: {}", isoTime(r.wallTime), log::levelName(r.level), r.category, r.message)));
-  }
-  out += s.logTail.empty() ? "]\n" : "\n  ]\n";
-  out += "}\n";
-  return out;
+  for (std::size_t i = first; i < s.logTail.size(); ++i) tail.push_back(logLine(s.logTail[i]));
+  return dumpJson(out, 2) + "\n";
 }
 
 std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {

@@ -20,6 +20,7 @@
 
 #include <fmt/format.h>
 #include <fmt/std.h>
+#include <nlohmann/json.hpp>
 
 #include "media/image_io.h"
 #include "runtime/log.h"
@@ -49,8 +50,8 @@ bool sameSecret(std::string_view expected, std::string_view given) {
 
 void replyJson(httplib::Response& res, int status, bool ok, std::string_view message) {
   res.status = status;
-  res.set_content(fmt::format("{{\"ok\": {}, \"status\": {}, \"message\": {}}}\n", ok ? "true" : "false", status,
-                              jsonString(message)),
+  const nlohmann::ordered_json answer{{"ok", ok}, {"status", status}, {"message", message}};
+  res.set_content(answer.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n",
                   "application/json");
 }
 

@@ -16,6 +16,8 @@
 #include <regex>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "media/image_io.h"
 #include "runtime/formats/cave.h"
 #include "support/kiosk_process.h"
@@ -95,47 +97,56 @@ class StatusServer : public testing::Test {
   std::unique_ptr<test::RunningShow> show_;
 };
 
+/// The object in `list` whose "name" is `name`, or null.
+nlohmann::json named(const nlohmann::json& list, const std::string& name) {
+  for (const auto& item : list) {
+    if (item.value("name", "") == name) return item;
+  }
+  return nullptr;
+}
+
 TEST_F(StatusServer, HealthReportsTheShowItsFramesAndItsDevices) {
   ::usleep(400000);  // a few frames, and the synthetic dial's first turn
   const auto h = show_->get("/health");
   ASSERT_EQ(h.status, 200) << h.body;
   EXPECT_EQ(h.headers.at("Content-Type"), "application/json");
-  EXPECT_NE(h.body.find("\"name\": \"Status test\""), std::string::npos) << h.body;
-  EXPECT_NE(h.body.find("\"state\": \"degraded\""), std::string::npos) << "the knob is absent: " << h.body;
-  EXPECT_NE(h.body.find("\"item\": \"first\""), std::string::npos) << h.body;
-  EXPECT_NE(h.body.find("\"mode\": \"active\""), std::string::npos) << h.body;
-  EXPECT_NE(h.body.find("\"name\": \"dials\", \"kind\": \"dial_box\", \"backend\": \"synthetic\", \"state\": \"live\""),
-            std::string::npos)
-      << h.body;
-  EXPECT_NE(h.body.find("\"name\": \"knob\", \"kind\": \"dial_box\", \"backend\": \"hid\", \"state\": \"absent\""),
-            std::string::npos)
-      << h.body;
-  EXPECT_NE(h.body.find("no hid 077d:0410 is plugged in"), std::string::npos) << "the reason: " << h.body;
-  EXPECT_NE(h.body.find("\"frame_time_ms\": {\"p50\": "), std::string::npos) << h.body;
-  EXPECT_EQ(h.body.find("\"frames\": {\n    \"total\": 0,"), std::string::npos) << "frames were drawn: " << h.body;
-  EXPECT_NE(h.body.find("\"frames\": {\n    \"total\": "), std::string::npos) << h.body;
-  EXPECT_NE(h.body.find("\"last_errors\": ["), std::string::npos) << h.body;
-  EXPECT_NE(h.body.find("\"uptime_seconds\": "), std::string::npos) << h.body;
+  ASSERT_TRUE(nlohmann::json::accept(h.body)) << h.body;
+  const auto health = nlohmann::json::parse(h.body);
+  EXPECT_EQ(health["show"]["name"], "Status test") << h.body;
+  EXPECT_EQ(health["state"], "degraded") << "the knob is absent: " << h.body;
+  EXPECT_EQ(health["show"]["item"], "first") << h.body;
+  EXPECT_EQ(health["show"]["mode"], "active") << h.body;
+  const auto dials = named(health["devices"], "dials");
+  ASSERT_TRUE(dials.is_object()) << h.body;
+  EXPECT_EQ(dials["kind"], "dial_box");
+  EXPECT_EQ(dials["backend"], "synthetic");
+  EXPECT_EQ(dials["state"], "live");
+  const auto knob = named(health["devices"], "knob");
+  ASSERT_TRUE(knob.is_object()) << h.body;
+  EXPECT_EQ(knob["backend"], "hid");
+  EXPECT_EQ(knob["state"], "absent");
+  EXPECT_NE(knob["message"].get<std::string>().find("no hid 077d:0410 is plugged in"), std::string::npos)
+      << "the reason: " << h.body;
+  EXPECT_TRUE(health["frames"]["frame_time_ms"]["p50"].is_number()) << h.body;
+  EXPECT_GT(health["frames"]["total"].get<std::int64_t>(), 0) << "frames were drawn: " << h.body;
+  EXPECT_TRUE(health["last_errors"].is_array()) << h.body;
+  EXPECT_TRUE(health["uptime_seconds"].is_number()) << h.body;
   // Each device says since when it is in its state (ISO 8601), and frames have a rate.
-  EXPECT_TRUE(std::regex_search(
-      h.body,
-      std::regex(R"re("name": "dials", [^}]*"state": "live", "since": "[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:.]+)re")))
-      << h.body;
-  EXPECT_TRUE(std::regex_search(
-      h.body,
-      std::regex(R"re("name": "knob", [^}]*"state": "absent", "since": "[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:.]+)re")))
-      << h.body;
-  std::smatch rate;
-  ASSERT_TRUE(std::regex_search(h.body, rate, std::regex(R"re("per_second": ([0-9.]+))re"))) << h.body;
-  EXPECT_GT(std::stod(rate[1]), 0.0) << h.body;
+  const std::regex iso(R"re([0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:.]+Z)re");
+  EXPECT_TRUE(std::regex_match(dials["since"].get<std::string>(), iso)) << h.body;
+  EXPECT_TRUE(std::regex_match(knob["since"].get<std::string>(), iso)) << h.body;
+  EXPECT_GT(health["frames"]["per_second"].get<double>(), 0.0) << h.body;
   // The camera's stream plays, and the camera's row says so (its state is its stream's).
-  EXPECT_NE(h.body.find("\"streams\": [\n    {\"name\": \"live\", \"kind\": \"camera\", \"state\": \"playing\""),
-            std::string::npos)
-      << h.body;
-  EXPECT_NE(h.body.find("{\"name\": \"cam\", \"kind\": \"camera\", \"backend\": \"synthetic\", \"state\": \"live\""),
-            std::string::npos)
-      << h.body;
-  EXPECT_NE(h.body.find("shown by texture 'camera': "), std::string::npos) << h.body;
+  ASSERT_EQ(health["streams"].size(), 1u) << h.body;
+  EXPECT_EQ(health["streams"][0]["name"], "live");
+  EXPECT_EQ(health["streams"][0]["kind"], "camera");
+  EXPECT_EQ(health["streams"][0]["state"], "playing");
+  const auto cam = named(health["devices"], "cam");
+  ASSERT_TRUE(cam.is_object()) << h.body;
+  EXPECT_EQ(cam["kind"], "camera");
+  EXPECT_EQ(cam["backend"], "synthetic");
+  EXPECT_EQ(cam["state"], "live");
+  EXPECT_TRUE(cam["message"].get<std::string>().starts_with("shown by texture 'camera': ")) << h.body;
 }
 
 TEST_F(StatusServer, MetricsAreValidPrometheusText) {
@@ -252,7 +263,9 @@ TEST_F(StatusServer, EachControlAnswersWhatItDid) {
   // The reload went through and the show is the same one.
   ::usleep(500000);
   const auto h = show_->get("/health");
-  EXPECT_NE(h.body.find("\"reloads\": {\"total\": 1, \"failed\": 0"), std::string::npos) << h.body;
+  const auto health = nlohmann::json::parse(h.body);
+  EXPECT_EQ(health["reloads"]["total"], 1) << h.body;
+  EXPECT_EQ(health["reloads"]["failed"], 0) << h.body;
 }
 
 TEST_F(StatusServer, MalformedAndOversizedRequestsAreRefused) {
