@@ -73,6 +73,17 @@ void StatusBoard::recordFrame(std::int64_t frame, double workSeconds, double int
   next_ = (next_ + 1) % kWindow;
   filled_ = std::min(filled_ + 1, kWindow);
   ++frames_;
+  ++workCount_;
+  workSum_ += workSeconds;
+  cpuSum_ += cpuSeconds;
+  if (frames_ > 1) {  // the first frame's "interval" is its start-up
+    const auto bucket = std::find_if(kFrameIntervalBuckets.begin(), kFrameIntervalBuckets.end(),
+                                     [intervalSeconds](double bound) { return intervalSeconds <= bound; });
+    if (bucket != kFrameIntervalBuckets.end())
+      ++intervalBuckets_[static_cast<std::size_t>(bucket - kFrameIntervalBuckets.begin())];
+    ++intervalCount_;
+    intervalSum_ += intervalSeconds;
+  }
   const bool late = frames_ > 1 && intervalSeconds > 1.5 / nominalFps_;
   const bool atReload = frame >= reloadFrame_ && frame <= reloadFrame_ + 2;
   if (atReload) longestAtReload_ = std::max(longestAtReload_, intervalSeconds);
@@ -162,6 +173,16 @@ FrameFigures StatusBoard::frameFigures() const {
     f.inputDropped = inputDropped_;
     f.droppedFrames = droppedFrames_;
     f.window = filled_;
+    std::uint64_t atOrUnder = 0;
+    for (std::size_t i = 0; i < intervalBuckets_.size(); ++i) {
+      atOrUnder += intervalBuckets_[i];
+      f.intervalBuckets[i] = atOrUnder;
+    }
+    f.intervalCount = intervalCount_;
+    f.intervalSum = intervalSum_;
+    f.workCount = workCount_;
+    f.workSum = workSum_;
+    f.cpuSum = cpuSum_;
     intervals.assign(intervals_.begin(), intervals_.begin() + static_cast<std::ptrdiff_t>(filled_));
     work.assign(work_.begin(), work_.begin() + static_cast<std::ptrdiff_t>(filled_));
     for (std::size_t i = 0; i < filled_; ++i) cpuSum += static_cast<double>(cpu_[i]);

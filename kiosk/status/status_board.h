@@ -17,6 +17,7 @@
 
 #include "kiosk/lock/lock_figures.h"
 #include "kiosk/policy/schedule.h"
+#include "kiosk/status/machine_facts.h"
 #include "runtime/bounded_queue.h"
 #include "runtime/clock.h"
 #include "runtime/image.h"
@@ -62,7 +63,15 @@ struct ShowStatus {
   std::shared_ptr<const Schedule> schedule;
 };
 
-/// \brief Figures derived from the recent frames.
+/// \brief Upper bounds (seconds) of the frame interval histogram's buckets: just above the frame
+/// periods of 60, 50, 30 and 25 Hz displays (16.7, 20, 33.3 and 40 ms), 1.5 periods at 60 Hz
+/// (late), and multiples up to 2.5 s. Fixed, so that the series stay the same across shows.
+inline constexpr std::array<double, 14> kFrameIntervalBuckets{0.005, 0.01,   0.0175, 0.021, 0.025, 0.035, 0.042,
+                                                              0.05,  0.0675, 0.1,    0.25,  0.5,   1.0,   2.5};
+/// \brief A count per bucket of kFrameIntervalBuckets.
+using IntervalBuckets = std::array<std::uint64_t, kFrameIntervalBuckets.size()>;
+
+/// \brief Figures derived from the recent frames, and totals since the start.
 struct FrameFigures {
   std::int64_t frames = 0;
   std::int64_t lateFrames = 0;      ///< a present more than 1.5 frame periods after the previous
@@ -78,6 +87,15 @@ struct FrameFigures {
   double cpuMean = 0;          ///< seconds of the loop thread's CPU time per frame, over the window
   double longestAtReload = 0;  ///< seconds: the longest present-to-present in the frames after a reload
   std::size_t window = 0;      ///< frames the percentiles are over
+  // Since the start (never decreasing, as Prometheus' counters, histograms and summaries are):
+  /// Present-to-present intervals at or under each of kFrameIntervalBuckets (cumulative, as a
+  /// histogram's `le` buckets are); the first frame's start-up is not an interval.
+  IntervalBuckets intervalBuckets{};
+  std::uint64_t intervalCount = 0;  ///< intervals in all
+  double intervalSum = 0;           ///< seconds
+  std::uint64_t workCount = 0;      ///< frames measured
+  double workSum = 0;               ///< seconds of the loop's own work
+  double cpuSum = 0;                ///< seconds of the loop thread's CPU time
 };
 
 /// \brief Everything the server reports, copied at one moment.
@@ -96,6 +114,8 @@ struct StatusSnapshot {
   std::uint64_t errorsLogged = 0;
   runtime::PerformanceMeter performance;  ///< LAVA's meter, as last sampled (updates == 0: not yet)
   std::optional<FrameLockFigures> lock;   ///< a frame-locked node's figures ([lock]); none otherwise
+  /// Filled by the status server when it reports, not by the board: the process's own figures.
+  std::optional<ProcessFigures> process;
 };
 
 /// \brief A request from the control server to the frame loop, answered through `reply`.
@@ -193,6 +213,12 @@ class StatusBoard {
   double longestAtReload_ = 0;              // guarded by mutex_
   std::uint64_t inputDropped_ = 0;          // guarded by mutex_
   std::int64_t droppedFrames_ = 0;          // guarded by mutex_
+  IntervalBuckets intervalBuckets_{};       // per bucket; guarded by mutex_
+  std::uint64_t intervalCount_ = 0;         // guarded by mutex_
+  double intervalSum_ = 0;                  // guarded by mutex_
+  std::uint64_t workCount_ = 0;             // guarded by mutex_
+  double workSum_ = 0;                      // guarded by mutex_
+  double cpuSum_ = 0;                       // guarded by mutex_
   runtime::PerformanceMeter performance_;   // guarded by mutex_
   std::optional<FrameLockFigures> lock_;    // guarded by mutex_
   ShowStatus show_;                         // guarded by mutex_

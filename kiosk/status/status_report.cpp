@@ -1,11 +1,14 @@
 #include "kiosk/status/status_report.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+
+#include "kiosk/status/build_info.h"
 
 namespace basalt::kiosk {
 
@@ -54,6 +57,35 @@ std::string dumpJson(const Json& json, int indent) {
 
 std::string logLine(const log::Record& r) {
   return fmt::format("{} {} {}: {}", isoTime(r.wallTime), log::levelName(r.level), r.category, r.message);
+}
+
+/// The states overallState() returns, each a series of basalt_state.
+constexpr std::array<std::string_view, 2> kStates{"ok", "degraded"};
+
+constexpr std::string_view kDeviceStateHelp =
+    "The device's state as a number: 0 absent, 1 opening, 2 live, 3 lost, 4 reopening, 5 idle (a camera no "
+    "texture shows), -1 another.";
+constexpr std::string_view kStreamStateHelp =
+    "The stream's state as a number: 0 absent, 1 waiting, 2 playing, 3 lost, -1 another.";
+
+int deviceStateNumber(std::string_view state) {
+  constexpr std::array<std::string_view, 6> kNames{"absent", "opening", "live", "lost", "reopening", "idle"};
+  const auto it = std::find(kNames.begin(), kNames.end(), state);
+  return it == kNames.end() ? -1 : static_cast<int>(it - kNames.begin());
+}
+
+int streamStateNumber(std::string_view state) {
+  constexpr std::array<std::string_view, 4> kNames{"absent", "waiting", "playing", "lost"};
+  const auto it = std::find(kNames.begin(), kNames.end(), state);
+  return it == kNames.end() ? -1 : static_cast<int>(it - kNames.begin());
+}
+
+/// A sample's value as Prometheus' text format writes it (NaN, +Inf, -Inf included), exact
+/// enough to read back.
+std::string number(double value) {
+  if (std::isnan(value)) return "NaN";
+  if (std::isinf(value)) return value > 0 ? "+Inf" : "-Inf";
+  return fmt::format("{}", value);
 }
 
 std::string promLabel(std::string_view text) {
@@ -206,8 +238,18 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
   const auto metric = [&out](std::string_view name, std::string_view type, std::string_view help) {
     out += fmt::format("# HELP {} {}\n# TYPE {} {}\n", name, help, name, type);
   };
-  metric("basalt_up", "gauge", "1 while the show runs; 0.5 when degraded (a device or stream is not live).");
-  out += fmt::format("basalt_up {}\n", overallState(s) == "ok" ? "1" : "0.5");
+  const BuildInfo build = buildInfo();
+  metric("basalt_build_info", "gauge", "Basalt's version and source revision, as labels; always 1.");
+  out += fmt::format("basalt_build_info{{version=\"{}\",revision=\"{}\"}} 1\n", promLabel(build.version),
+                     promLabel(build.revision));
+  metric("basalt_up", "gauge", "1 while the show runs (from its first frame on), 0 before; basalt_state says how.");
+  out += fmt::format("basalt_up {}\n", f.frames > 0 ? 1 : 0);
+  metric("basalt_state", "gauge",
+         "1 for the show's state (\"ok\", or \"degraded\": a device, stream or frame-lock peer is missing).");
+  const std::string_view state = overallState(s);
+  for (const std::string_view known : kStates) {
+    out += fmt::format("basalt_state{{state=\"{}\"}} {}\n", known, state == known ? 1 : 0);
+  }
   metric("basalt_start_time_seconds", "gauge", "When the process started, in seconds since 1970.");
   out += fmt::format("basalt_start_time_seconds {:.3f}\n", unixSeconds(s.startedAt));
   metric("basalt_uptime_seconds", "gauge", "Seconds since the process started.");
@@ -220,21 +262,25 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
   out += fmt::format("basalt_frames_missed_at_reload_total {}\n", f.missedAtReload);
   metric("basalt_frames_per_second", "gauge", "Frames per second over the recent window.");
   out += fmt::format("basalt_frames_per_second {:.3f}\n", f.framesPerSecond);
-  metric("basalt_frame_interval_seconds", "summary", "Time from one present to the next, recent frames.");
-  for (const auto& [q, v] : {std::pair{"0.5", f.intervalP50}, {"0.9", f.intervalP90}, {"0.99", f.intervalP99}}) {
-    out += fmt::format("basalt_frame_interval_seconds{{quantile=\"{}\"}} {:.6f}\n", q, v);
+  metric("basalt_frame_interval_seconds", "histogram", "Time from one present to the next.");
+  for (std::size_t i = 0; i < kFrameIntervalBuckets.size(); ++i) {
+    out += fmt::format("basalt_frame_interval_seconds_bucket{{le=\"{}\"}} {}\n", kFrameIntervalBuckets[i],
+                       f.intervalBuckets[i]);
   }
-  out += fmt::format("basalt_frame_interval_seconds_count {}\n", f.window);
-  metric("basalt_frame_work_seconds", "summary", "The frame loop's own work per frame, recent frames.");
+  out += fmt::format("basalt_frame_interval_seconds_bucket{{le=\"+Inf\"}} {}\n", f.intervalCount);
+  out += fmt::format("basalt_frame_interval_seconds_sum {}\n", number(f.intervalSum));
+  out += fmt::format("basalt_frame_interval_seconds_count {}\n", f.intervalCount);
+  metric("basalt_frame_work_seconds", "summary",
+         "The frame loop's own work per frame: quantiles over the recent frames, sum and count since the start.");
   for (const auto& [q, v] : {std::pair{"0.5", f.workP50}, {"0.9", f.workP90}, {"0.99", f.workP99}}) {
-    out += fmt::format("basalt_frame_work_seconds{{quantile=\"{}\"}} {:.6f}\n", q, v);
+    out += fmt::format("basalt_frame_work_seconds{{quantile=\"{}\"}} {}\n", q, number(v));
   }
-  out += fmt::format("basalt_frame_work_seconds_sum {:.6f}\n", f.workMean * static_cast<double>(f.window));
-  out += fmt::format("basalt_frame_work_seconds_count {}\n", f.window);
+  out += fmt::format("basalt_frame_work_seconds_sum {}\n", number(f.workSum));
+  out += fmt::format("basalt_frame_work_seconds_count {}\n", f.workCount);
   metric("basalt_frame_work_cpu_seconds", "summary",
-         "The frame loop thread's CPU time per frame (its work without preemption), recent frames.");
-  out += fmt::format("basalt_frame_work_cpu_seconds_sum {:.6f}\n", f.cpuMean * static_cast<double>(f.window));
-  out += fmt::format("basalt_frame_work_cpu_seconds_count {}\n", f.window);
+         "The frame loop thread's CPU time per frame (its work without preemption), since the start.");
+  out += fmt::format("basalt_frame_work_cpu_seconds_sum {}\n", number(f.cpuSum));
+  out += fmt::format("basalt_frame_work_cpu_seconds_count {}\n", f.workCount);
   metric("basalt_frame_interval_at_reload_max_seconds", "gauge",
          "The longest present-to-present in the three frames after a reload took over.");
   out += fmt::format("basalt_frame_interval_at_reload_max_seconds {:.6f}\n", f.longestAtReload);
@@ -270,20 +316,36 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
   metric("basalt_item_info", "gauge", "The item playing now.");
   out += fmt::format("basalt_item_info{{show=\"{}\",item=\"{}\",index=\"{}\",count=\"{}\"}} 1\n",
                      promLabel(s.show.name), promLabel(s.show.item), s.show.index, s.show.count);
+  // A device's and a stream's series keep their labels whatever their state: the state is a value.
+  metric("basalt_device_info", "gauge", "The show's devices: kind and backend as labels; always 1.");
+  for (const DeviceStatus& d : s.devices) {
+    out += fmt::format("basalt_device_info{{device=\"{}\",kind=\"{}\",backend=\"{}\"}} 1\n", promLabel(d.name),
+                       promLabel(d.kind), promLabel(d.backend));
+  }
   metric("basalt_device_up", "gauge", "1 while the device is live.");
   for (const DeviceStatus& d : s.devices) {
-    out += fmt::format("basalt_device_up{{device=\"{}\",kind=\"{}\",backend=\"{}\",state=\"{}\"}} {}\n",
-                       promLabel(d.name), d.kind, d.backend, d.state, d.state == "live" ? 1 : 0);
+    out += fmt::format("basalt_device_up{{device=\"{}\"}} {}\n", promLabel(d.name), d.state == "live" ? 1 : 0);
+  }
+  metric("basalt_device_state", "gauge", std::string(kDeviceStateHelp));
+  for (const DeviceStatus& d : s.devices) {
+    out += fmt::format("basalt_device_state{{device=\"{}\"}} {}\n", promLabel(d.name), deviceStateNumber(d.state));
   }
   metric("basalt_device_state_since_seconds", "gauge", "When the device entered its state, seconds since 1970.");
   for (const DeviceStatus& d : s.devices) {
     out += fmt::format("basalt_device_state_since_seconds{{device=\"{}\"}} {:.3f}\n", promLabel(d.name),
                        unixSeconds(d.since));
   }
+  metric("basalt_stream_info", "gauge", "The show's streams (movies, camera textures): kind as a label; always 1.");
+  for (const StreamStatus& st : s.streams) {
+    out += fmt::format("basalt_stream_info{{stream=\"{}\",kind=\"{}\"}} 1\n", promLabel(st.name), promLabel(st.kind));
+  }
   metric("basalt_stream_up", "gauge", "1 while the stream plays.");
   for (const StreamStatus& st : s.streams) {
-    out += fmt::format("basalt_stream_up{{stream=\"{}\",kind=\"{}\",state=\"{}\"}} {}\n", promLabel(st.name), st.kind,
-                       st.state, st.state == "playing" ? 1 : 0);
+    out += fmt::format("basalt_stream_up{{stream=\"{}\"}} {}\n", promLabel(st.name), st.state == "playing" ? 1 : 0);
+  }
+  metric("basalt_stream_state", "gauge", std::string(kStreamStateHelp));
+  for (const StreamStatus& st : s.streams) {
+    out += fmt::format("basalt_stream_state{{stream=\"{}\"}} {}\n", promLabel(st.name), streamStateNumber(st.state));
   }
   if (const std::optional<FrameLockFigures>& l = s.lock) {
     const auto lockMetric = [&](std::string_view name, std::string_view type, std::string_view help, auto value) {
@@ -299,8 +361,8 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
                  l->followersDropped);
       lockMetric("basalt_lock_late_answers_total", "counter", "Followers' answers for frames already presented.",
                  l->lateAnswers);
-      lockMetric("basalt_lock_barrier_wait_ms", "gauge", "The leader's median wait for the answers (ms).",
-                 fmt::format("{:.3f}", l->barrierWaitP50Ms));
+      lockMetric("basalt_lock_barrier_wait_seconds", "gauge", "The leader's median wait for the answers.",
+                 number(l->barrierWaitP50Ms / 1e3));
     } else {
       lockMetric("basalt_lock_leader_present", "gauge", "1 while the leader is heard.", l->leaderPresent ? 1 : 0);
       lockMetric("basalt_lock_leader_lost_total", "counter", "Times the leader went quiet.", l->leaderLost);
@@ -314,8 +376,8 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
                  l->presentsMissed);
       lockMetric("basalt_lock_skew_frames_max", "gauge", "Largest lead of the leader's presented frame over ours.",
                  l->maxSkewFrames);
-      lockMetric("basalt_lock_clock_offset_us", "gauge", "The shared clock minus this node's clock (us).",
-                 l->clockOffsetUs);
+      lockMetric("basalt_lock_clock_offset_seconds", "gauge", "The shared clock minus this node's clock.",
+                 number(static_cast<double>(l->clockOffsetUs) / 1e6));
     }
     lockMetric("basalt_lock_malformed_total", "counter", "Frame-lock messages rejected.", l->malformed);
     lockMetric("basalt_lock_commands_applied_total", "counter",
@@ -346,6 +408,23 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
   out += fmt::format("basalt_http_rejected_total{{reason=\"rate\"}} {}\n", server.rejectedRate);
   out += fmt::format("basalt_http_rejected_total{{reason=\"auth\"}} {}\n", server.rejectedAuth);
   out += fmt::format("basalt_http_rejected_total{{reason=\"size\"}} {}\n", server.rejectedSize);
+  if (const std::optional<ProcessFigures>& p = s.process) {
+    // The names and meanings of Prometheus' client libraries, so that the usual dashboards work.
+    metric("process_cpu_seconds_total", "counter", "Total user and system CPU time spent in seconds.");
+    out += fmt::format("process_cpu_seconds_total {}\n", number(p->cpuSeconds));
+    metric("process_resident_memory_bytes", "gauge", "Resident memory size in bytes.");
+    out += fmt::format("process_resident_memory_bytes {}\n", p->residentBytes);
+    metric("process_virtual_memory_bytes", "gauge", "Virtual memory size in bytes.");
+    out += fmt::format("process_virtual_memory_bytes {}\n", p->virtualBytes);
+    metric("process_open_fds", "gauge", "Number of open file descriptors.");
+    out += fmt::format("process_open_fds {}\n", p->openFds);
+    metric("process_max_fds", "gauge", "Maximum number of open file descriptors.");
+    out += fmt::format("process_max_fds {}\n", p->maxFds);
+    if (p->startSeconds) {
+      metric("process_start_time_seconds", "gauge", "Start time of the process since unix epoch in seconds.");
+      out += fmt::format("process_start_time_seconds {:.2f}\n", *p->startSeconds);
+    }
+  }
   return out;
 }
 

@@ -296,7 +296,9 @@ void StatusServer::routes() {
     res.set_content(healthJson(board_.snapshot(now())), "application/json");
   });
   http.Get("/metrics", [this, now](const httplib::Request&, httplib::Response& res) {
-    res.set_content(metricsText(board_.snapshot(now()), counters()), "text/plain; version=0.0.4; charset=utf-8");
+    StatusSnapshot snapshot = board_.snapshot(now());
+    snapshot.process = readProcessFigures();
+    res.set_content(metricsText(snapshot, counters()), "text/plain; version=0.0.4; charset=utf-8");
   });
   http.Get("/", [](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");

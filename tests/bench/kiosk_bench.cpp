@@ -16,6 +16,7 @@
 #include <chrono>
 #include <filesystem>
 #include <optional>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -94,6 +95,13 @@ double metric(const std::string& text, const std::string& name) {
   return -1;
 }
 
+/// The median present-to-present time over the recent frames, from /health.
+double medianFrameMs(const std::string& health) {
+  std::smatch m;
+  if (!std::regex_search(health, m, std::regex(R"re("frame_time_ms": \{\s*"p50": ([0-9.]+))re"))) return -1;
+  return std::stod(m[1].str());
+}
+
 /// A default show running in real time at 60 fps with its status server on a free port.
 struct RealtimeShow {
   basalt::test::Process process;
@@ -135,12 +143,13 @@ void reloadGap(benchmark::State& state) {
       std::this_thread::sleep_for(600ms);
     }
     const std::string metrics = get(running->port, "/metrics");
+    const std::string health = get(running->port, "/health");
     running->process.signal(SIGTERM);
     running->process.wait(20s);
     reloadFigures.reloads = static_cast<int>(metric(metrics, "basalt_reloads_total"));
     reloadFigures.missed = metric(metrics, "basalt_frames_missed_at_reload_total");
     reloadFigures.longestMs = metric(metrics, "basalt_frame_interval_at_reload_max_seconds") * 1e3;
-    reloadFigures.medianMs = metric(metrics, "basalt_frame_interval_seconds{quantile=\"0.5\"}") * 1e3;
+    reloadFigures.medianMs = medianFrameMs(health);
     state.counters["missed"] = reloadFigures.missed;
     state.counters["longest_ms"] = reloadFigures.longestMs;
     state.SetIterationTime(1);
@@ -157,14 +166,23 @@ struct ServerCost {
 };
 ServerCost serverCost;
 
-/// Mean work per frame over the last 600 frames (10 s at 60 fps): wall time and the loop
-/// thread's CPU time.
-std::pair<double, double> meanWorkMs(std::uint16_t port) {
+/// The loop's work since the start: frames, and seconds of wall time and of its thread's CPU time.
+struct WorkTotals {
+  double frames = -1;
+  double wall = 0;
+  double cpu = 0;
+};
+WorkTotals workTotals(std::uint16_t port) {
   const std::string m = get(port, "/metrics");
-  const double count = metric(m, "basalt_frame_work_seconds_count");
-  if (count <= 0) return {-1, -1};
-  return {metric(m, "basalt_frame_work_seconds_sum") / count * 1e3,
-          metric(m, "basalt_frame_work_cpu_seconds_sum") / count * 1e3};
+  return {metric(m, "basalt_frame_work_seconds_count"), metric(m, "basalt_frame_work_seconds_sum"),
+          metric(m, "basalt_frame_work_cpu_seconds_sum")};
+}
+
+/// Mean work per frame between two readings (wall time and the loop thread's CPU time), in ms.
+std::pair<double, double> meanWorkMs(const WorkTotals& from, const WorkTotals& to) {
+  const double frames = to.frames - from.frames;
+  if (from.frames < 0 || frames <= 0) return {-1, -1};
+  return {(to.wall - from.wall) / frames * 1e3, (to.cpu - from.cpu) / frames * 1e3};
 }
 
 void statusServerCost(benchmark::State& state) {
@@ -175,8 +193,11 @@ void statusServerCost(benchmark::State& state) {
       return;
     }
     // Ten seconds with the server idle: the baseline, in the same process.
-    std::this_thread::sleep_for(10500ms);
-    std::tie(serverCost.idleWorkMs, serverCost.idleCpuMs) = meanWorkMs(running->port);
+    std::this_thread::sleep_for(500ms);
+    const WorkTotals start = workTotals(running->port);
+    std::this_thread::sleep_for(10s);
+    const WorkTotals idle = workTotals(running->port);
+    std::tie(serverCost.idleWorkMs, serverCost.idleCpuMs) = meanWorkMs(start, idle);
     // Ten seconds at 10 requests a second, the status page's mix.
     const char* mix[] = {"/health", "/health", "/metrics", "/health", "/snapshot.png?w=480",
                          "/health", "/health", "/metrics", "/health", "/health"};
@@ -186,7 +207,7 @@ void statusServerCost(benchmark::State& state) {
       std::this_thread::sleep_until(begin + i * 100ms);
       if (!get(running->port, mix[i % 10]).empty()) ++requests;
     }
-    std::tie(serverCost.loadedWorkMs, serverCost.loadedCpuMs) = meanWorkMs(running->port);
+    std::tie(serverCost.loadedWorkMs, serverCost.loadedCpuMs) = meanWorkMs(idle, workTotals(running->port));
     serverCost.requests = requests;
     running->process.signal(SIGTERM);
     running->process.wait(20s);

@@ -721,7 +721,9 @@ TEST(FrameLockStatus, FiguresReachHealthAndMetrics) {
   const std::string metrics = metricsText(s, ServerCounters{});
   EXPECT_NE(metrics.find("basalt_lock_frames_skipped_total{node=\"north\",role=\"follower\"} 4"), std::string::npos)
       << metrics;
-  EXPECT_NE(metrics.find("basalt_lock_clock_offset_us{node=\"north\",role=\"follower\"} -35"), std::string::npos);
+  EXPECT_NE(metrics.find("basalt_lock_clock_offset_seconds{node=\"north\",role=\"follower\"} -3.5e-05"),
+            std::string::npos)
+      << metrics;
   EXPECT_EQ(health["lock"]["movie_frames_corrected"], 12) << health;
   EXPECT_EQ(health["lock"]["movie_frames_late"], 1) << health;
   EXPECT_NE(metrics.find("basalt_lock_movie_frames_corrected_total{node=\"north\",role=\"follower\"} 12"),

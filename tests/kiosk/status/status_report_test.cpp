@@ -11,11 +11,17 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <sstream>
 
+#include <unistd.h>
+
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "kiosk/status/build_info.h"
 #include "kiosk/status/status_board.h"
 #include "kiosk/status/status_report.h"
+#include "support/kiosk_process.h"
 #include "support/process.h"
 #include "support/test_paths.h"
 
@@ -144,6 +150,182 @@ print(json.dumps(doc["log_tail"][0][-35:]))
   EXPECT_EQ(python.output, expected) << text;
   // The writer's own library reads it too, strictly (no NaN).
   EXPECT_TRUE(nlohmann::json::accept(text)) << text;
+}
+
+/// A snapshot with everything /metrics can say: devices and streams in several states, a
+/// frame-locked node's figures, the process's figures, and some frames.
+StatusSnapshot everything(bool leader) {
+  StatusBoard board(WallTime{}, 60);
+  std::int64_t frame = 0;
+  for (const double interval : {0.5, 0.016, 0.017, 0.018, 0.020, 0.034, 0.050, 3.0}) {
+    board.recordFrame(frame++, 0.002, interval, 0.001, 0);
+  }
+  StatusSnapshot s = board.snapshot(WallTime{});
+  const auto device = [](std::string name, std::string state) {
+    DeviceStatus d;
+    d.name = std::move(name);
+    d.kind = "dial_box";
+    d.backend = "hid";
+    d.state = std::move(state);
+    return d;
+  };
+  s.devices = {device("dials", "live"), device("knob \"2\"", "absent"), device("cam", "idle")};
+  StreamStatus st;
+  st.name = "live";
+  st.kind = "camera";
+  st.state = "lost";
+  s.streams = {st};
+  FrameLockFigures lock;
+  lock.leader = leader;
+  lock.node = "north";
+  lock.clockOffsetUs = -35;
+  lock.barrierWaitP50Ms = 1.5;
+  s.lock = lock;
+  s.process = readProcessFigures();
+  return s;
+}
+
+/// `promtool check metrics` on `text`: its output, and whether it found nothing to say.
+std::pair<bool, std::string> promtool(const std::string& text) {
+  const auto file = test::scratchDir("status-promtool") / "metrics.txt";
+  std::ofstream(file) << text;
+  const auto r = test::run({"/bin/sh", "-c", "promtool check metrics < '" + file.string() + "'"});
+  return {r.exitCode == 0 && r.output.empty(), r.output};
+}
+
+// Makes sure /metrics follows Prometheus' conventions as promtool checks them (names, units,
+// help, types), whatever the show has: a leader's and a follower's lock figures, devices and
+// streams in every state, the process's figures. Example failure: a gauge named in
+// milliseconds; a counter without _total.
+TEST(StatusMetrics, PromtoolFindsNothingToSay) {
+  if (::access("/usr/bin/promtool", X_OK) != 0) {
+    GTEST_SKIP() << "promtool is not installed (apt-get install prometheus; it is in scripts/packages.txt)";
+  }
+  for (const bool leader : {true, false}) {
+    const std::string text = metricsText(everything(leader), ServerCounters{});
+    const auto [clean, output] = promtool(text);
+    EXPECT_TRUE(clean) << output << "\n" << text;
+  }
+}
+
+// Makes sure the state is a gauge of its own and basalt_up is 0 or 1, and that a device's and a
+// stream's series keep their labels when their state changes. Example failures: basalt_up 0.5
+// when degraded; basalt_device_up{...,state="lost"}, a new series at every change.
+TEST(StatusMetrics, StateIsAValueNotALabel) {
+  StatusSnapshot s = everything(false);
+  const std::string degraded = metricsText(s, {});
+  EXPECT_EQ(test::metric(degraded, "basalt_up"), 1.0) << degraded;
+  EXPECT_EQ(test::metric(degraded, "basalt_state{state=\"degraded\"}"), 1.0) << degraded;
+  EXPECT_EQ(test::metric(degraded, "basalt_state{state=\"ok\"}"), 0.0) << degraded;
+  EXPECT_EQ(test::metric(degraded, "basalt_device_up{device=\"dials\"}"), 1.0);
+  EXPECT_EQ(test::metric(degraded, "basalt_device_up{device=\"knob \\\"2\\\"\"}"), 0.0) << degraded;
+  EXPECT_EQ(test::metric(degraded, "basalt_device_state{device=\"dials\"}"), 2.0);
+  EXPECT_EQ(test::metric(degraded, "basalt_device_state{device=\"knob \\\"2\\\"\"}"), 0.0);
+  EXPECT_EQ(test::metric(degraded, "basalt_device_state{device=\"cam\"}"), 5.0);
+  EXPECT_EQ(test::metric(degraded, "basalt_device_info{device=\"dials\",kind=\"dial_box\",backend=\"hid\"}"), 1.0);
+  EXPECT_EQ(test::metric(degraded, "basalt_stream_up{stream=\"live\"}"), 0.0);
+  EXPECT_EQ(test::metric(degraded, "basalt_stream_state{stream=\"live\"}"), 3.0);
+
+  // Everything back: the same series, other values.
+  s.devices[1].state = "live";
+  s.streams[0].state = "playing";
+  s.lock->leaderPresent = true;
+  const std::string ok = metricsText(s, {});
+  EXPECT_EQ(test::metric(ok, "basalt_up"), 1.0);
+  EXPECT_EQ(test::metric(ok, "basalt_state{state=\"ok\"}"), 1.0) << ok;
+  EXPECT_EQ(test::metric(ok, "basalt_state{state=\"degraded\"}"), 0.0);
+  EXPECT_EQ(test::metric(ok, "basalt_device_state{device=\"knob \\\"2\\\"\"}"), 2.0);
+  EXPECT_EQ(test::metric(ok, "basalt_stream_state{stream=\"live\"}"), 2.0);
+  const auto series = [](const std::string& text) {
+    std::vector<std::string> names;
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) {
+      if (!line.starts_with("#")) names.push_back(line.substr(0, line.rfind(' ')));
+    }
+    return names;
+  };
+  EXPECT_EQ(series(degraded), series(ok)) << "the same series whatever the states";
+
+  // Before the first frame the show does not run yet.
+  StatusBoard fresh(WallTime{}, 60);
+  EXPECT_EQ(test::metric(metricsText(fresh.snapshot(WallTime{}), {}), "basalt_up"), 0.0);
+}
+
+// Makes sure frame intervals are a histogram with cumulative buckets, _sum and _count since the
+// start (the first frame's start-up left out), and that the work summary's sum and count are
+// totals too. Example failures: a summary without _sum; a count that stops at the window's 600.
+TEST(StatusMetrics, FrameIntervalsAreAHistogram) {
+  StatusBoard board(WallTime{}, 60);
+  // 0.5 s of start-up (not an interval), then intervals around the bucket bounds.
+  const std::vector<double> intervals{0.5, 0.016, 0.0175, 0.018, 0.020, 0.034, 0.050, 3.0};
+  std::int64_t frame = 0;
+  for (const double v : intervals) board.recordFrame(frame++, 0.002, v, 0.001, 0);
+  for (int i = 0; i < 700; ++i) board.recordFrame(frame++, 0.001, 1.0 / 60, 0.0005, 0);
+  const std::string text = metricsText(board.snapshot(WallTime{}), {});
+  EXPECT_TRUE(has(text, "# TYPE basalt_frame_interval_seconds histogram\n")) << text;
+  // Expected counts, worked out by hand from the intervals above and the bounds in
+  // kiosk/status/README.md: 1/60 s falls in le="0.0175".
+  const std::vector<std::pair<std::string, double>> buckets{
+      {"0.005", 0},   {"0.01", 0},    {"0.0175", 702}, {"0.021", 704},  {"0.025", 704},
+      {"0.035", 705}, {"0.042", 705}, {"0.05", 706},   {"0.0675", 706}, {"0.1", 706},
+      {"0.25", 706},  {"0.5", 706},   {"1", 706},      {"2.5", 706},    {"+Inf", 707}};
+  for (const auto& [le, count] : buckets) {
+    EXPECT_EQ(test::metric(text, "basalt_frame_interval_seconds_bucket{le=\"" + le + "\"}"), count) << le << "\n"
+                                                                                                    << text;
+  }
+  EXPECT_EQ(test::metric(text, "basalt_frame_interval_seconds_count"), 707.0);
+  const double sum = 0.016 + 0.0175 + 0.018 + 0.020 + 0.034 + 0.050 + 3.0 + 700.0 / 60;
+  EXPECT_NEAR(test::metric(text, "basalt_frame_interval_seconds_sum").value_or(0), sum, 1e-9);
+  EXPECT_EQ(test::metric(text, "basalt_frame_work_seconds_count"), 708.0);
+  EXPECT_NEAR(test::metric(text, "basalt_frame_work_seconds_sum").value_or(0), 8 * 0.002 + 700 * 0.001, 1e-9);
+  EXPECT_NEAR(test::metric(text, "basalt_frame_work_cpu_seconds_sum").value_or(0), 8 * 0.001 + 700 * 0.0005, 1e-9);
+  EXPECT_EQ(test::metric(text, "basalt_frame_work_cpu_seconds_count"), 708.0);
+  EXPECT_FALSE(has(text, "basalt_frame_interval_seconds{quantile")) << "a histogram, not a summary";
+}
+
+// Makes sure the build and the process are reported under the names Prometheus' client
+// libraries use, with figures that agree with what the kernel says through other files.
+// Example failures: no basalt_build_info; open descriptors counted without the ones just opened.
+TEST(StatusMetrics, BuildAndProcessFigures) {
+  const StatusSnapshot s = everything(true);
+  const std::string text = metricsText(s, {});
+  const BuildInfo build = buildInfo();
+  EXPECT_FALSE(build.version.empty());
+  EXPECT_EQ(test::metric(text, fmt::format("basalt_build_info{{version=\"{}\",revision=\"{}\"}}", build.version,
+                                           build.revision)),
+            1.0)
+      << text;
+  // Resident memory as /proc/self/status says it (in kB), within what a few allocations move.
+  std::ifstream status("/proc/self/status");
+  double residentKb = 0;
+  for (std::string line; std::getline(status, line);) {
+    if (line.starts_with("VmRSS:")) residentKb = std::stod(line.substr(6));
+  }
+  const ProcessFigures before = readProcessFigures();
+  EXPECT_NEAR(static_cast<double>(before.residentBytes) / 1024, residentKb, 4096);
+  EXPECT_EQ(test::metric(text, "process_resident_memory_bytes").value_or(0) > 0, true) << text;
+  // Ten more descriptors are ten more.
+  std::vector<int> fds;
+  for (int i = 0; i < 10; ++i) fds.push_back(::dup(1));
+  const ProcessFigures opened = readProcessFigures();
+  for (const int fd : fds) ::close(fd);
+  EXPECT_EQ(opened.openFds, before.openFds + 10);
+  EXPECT_GT(before.openFds, 2u) << "stdin, stdout and stderr at least";
+  // CPU time grows with work done.
+  volatile double x = 0;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+  while (std::chrono::steady_clock::now() < until) x = x + 1;
+  const ProcessFigures later = readProcessFigures();
+  EXPECT_GE(later.cpuSeconds - before.cpuSeconds, 0.1);
+  // The process started before now, and not before this test binary's file was written.
+  ASSERT_TRUE(before.startSeconds);
+  const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  EXPECT_LE(*before.startSeconds, now);
+  EXPECT_GT(*before.startSeconds, now - 3600) << "a test binary runs for less than an hour";
+  for (const char* name : {"process_cpu_seconds_total", "process_resident_memory_bytes", "process_open_fds",
+                           "process_max_fds", "process_virtual_memory_bytes", "process_start_time_seconds"}) {
+    EXPECT_TRUE(test::metric(text, name)) << name << "\n" << text;
+  }
 }
 
 }  // namespace
