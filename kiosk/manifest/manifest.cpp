@@ -1851,7 +1851,9 @@ class Reader {
     StatusSpec& s = manifest_.status;
     s.enabled = true;
     s.line = lineOf(t);
-    checkKeys(t, "status", {"enabled", "listen", "token", "token_file", "max_request_bytes", "requests_per_second"});
+    checkKeys(t, "status",
+              {"enabled", "listen", "token", "token_file", "max_request_bytes", "requests_per_second", "read_token",
+               "read_token_file", "snapshot"});
     if (auto enabled = boolean(t, "enabled", "status")) s.enabled = *enabled;
     if (auto listen = string(t, "listen", "status")) readListen(*listen, lineOf(*t.get("listen")));
     if (auto token = string(t, "token", "status")) {
@@ -1881,6 +1883,37 @@ class Reader {
       s.maxRequestBytes = static_cast<std::size_t>(*bytes);
     }
     if (auto rate = number(t, "requests_per_second", "status", 1, 1000)) s.requestsPerSecond = *rate;
+    if (auto snapshot = boolean(t, "snapshot", "status")) s.snapshot = *snapshot;
+    if (auto token = string(t, "read_token", "status")) {
+      if (token->size() < 16) {
+        error(lineOf(*t.get("read_token")),
+              "status.read_token: at least 16 characters; make one with 'openssl rand -hex 16'");
+      } else {
+        s.readToken = *token;
+      }
+    }
+    if (auto tokenFile = string(t, "read_token_file", "status")) {
+      std::filesystem::path p(*tokenFile);
+      if (p.is_relative()) p = folder_ / p;
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(p, ec)) {
+        warning(lineOf(*t.get("read_token_file")),
+                fmt::format("status.read_token_file: '{}' does not exist yet; other machines cannot read the status "
+                            "until it does (make it with: openssl rand -hex 16 > {})",
+                            *tokenFile, p.string()));
+      }
+      s.readTokenFile = p;
+      if (t.get("read_token")) {
+        error(lineOf(*t.get("read_token_file")), "status: give read_token or read_token_file, not both");
+      }
+    }
+    if (s.loopbackOnly() && (t.get("read_token") || t.get("read_token_file"))) {
+      const char* key = t.get("read_token") ? "read_token" : "read_token_file";
+      warning(lineOf(*t.get(key)),
+              fmt::format("status.{}: the server listens on {}, which only this machine reaches, and this machine "
+                          "reads without a token; the token takes effect with a listen address other machines reach",
+                          key, s.host));
+    }
     if (s.enabled && !s.loopbackOnly() && s.token.empty() && s.tokenFile.empty()) {
       error(t.get("listen") ? lineOf(*t.get("listen")) : s.line,
             fmt::format("status.listen: '{}' opens the server beyond this machine; that needs token_file (controls "

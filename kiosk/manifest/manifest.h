@@ -307,6 +307,11 @@ struct StatusSpec {
   std::filesystem::path tokenFile;  ///< or the token is read from this file (may be outside the show)
   std::size_t maxRequestBytes = std::size_t{16} * 1024;
   double requestsPerSecond = 20;  ///< per client address
+  /// GETs from other machines need "Authorization: Bearer READ_TOKEN" (or HTTP Basic with it as
+  /// the password; the control token serves too); empty: no token needed to read.
+  std::string readToken;
+  std::filesystem::path readTokenFile;  ///< or the read token is read from this file
+  bool snapshot = true;                 ///< GET /snapshot.png serves the frame on screen
   int line = 0;
   /// \brief True when `host` is a loopback address (127.0.0.0/8, ::1, "localhost").
   [[nodiscard]] bool loopbackOnly() const;

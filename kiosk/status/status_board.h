@@ -98,6 +98,13 @@ struct FrameFigures {
   double cpuSum = 0;                ///< seconds of the loop thread's CPU time
 };
 
+/// \brief How the status server itself is set up, for the page (what to show, what to hide).
+struct ServerFacts {
+  bool controls = false;   ///< POST /control/... is on (a token is configured and readable)
+  bool snapshot = true;    ///< GET /snapshot.png serves the frame on screen
+  bool readToken = false;  ///< GETs from other machines need the read token
+};
+
 /// \brief Everything the server reports, copied at one moment.
 struct StatusSnapshot {
   WallTime now{};
@@ -114,8 +121,9 @@ struct StatusSnapshot {
   std::uint64_t errorsLogged = 0;
   runtime::PerformanceMeter performance;  ///< LAVA's meter, as last sampled (updates == 0: not yet)
   std::optional<FrameLockFigures> lock;   ///< a frame-locked node's figures ([lock]); none otherwise
-  /// Filled by the status server when it reports, not by the board: the process's own figures.
-  std::optional<ProcessFigures> process;
+  // Filled by the status server when it reports, not by the board:
+  std::optional<ProcessFigures> process;  ///< the process's own figures (/metrics)
+  std::optional<ServerFacts> server;      ///< the server's set-up (/health)
 };
 
 /// \brief A request from the control server to the frame loop, answered through `reply`.

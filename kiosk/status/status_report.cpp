@@ -229,6 +229,9 @@ std::string healthJson(const StatusSnapshot& s) {
   Json& tail = out["log_tail"] = Json::array();
   const std::size_t first = s.logTail.size() > 30 ? s.logTail.size() - 30 : 0;
   for (std::size_t i = first; i < s.logTail.size(); ++i) tail.push_back(logLine(s.logTail[i]));
+  if (const std::optional<ServerFacts>& server = s.server) {
+    out["server"] = {{"controls", server->controls}, {"snapshot", server->snapshot}, {"read_token", server->readToken}};
+  }
   return dumpJson(out, 2) + "\n";
 }
 
@@ -486,7 +489,8 @@ std::string_view statusPageHtml() {
 <body>
 <header><h1 id="show">Basalt</h1><span id="state">…</span></header>
 <main>
-  <section><h2>On screen</h2><img id="thumb" alt="the frame on screen now" src="/snapshot.png?w=480">
+  <section><h2>On screen</h2><img id="thumb" alt="the frame on screen now" hidden>
+    <p id="snapshot-off" hidden>The snapshot is off in this show ([status] snapshot = false).</p>
     <p id="item"></p></section>
   <section><h2>Frames</h2><div class="figures">
     <div class="figure"><b id="fps">–</b>frames per second</div>
@@ -531,11 +535,15 @@ async function refresh() {
     rows($("devices"), h.devices, (d) => [[d.name], [d.state, d.state], [d.backend + (d.message ? " · " + d.message : "")], ["for " + since(d.since)]]);
     rows($("streams"), h.streams, (s) => [[s.name], [s.state, s.state], [s.message]]);
     $("log").textContent = h.log_tail.join("\n");
+    snapshotOn = !h.server || h.server.snapshot;
+    $("thumb").hidden = !snapshotOn; $("snapshot-off").hidden = snapshotOn;
+    if (snapshotOn && !$("thumb").getAttribute("src")) refreshThumb();
   } catch (e) {
     $("state").textContent = "unreachable"; $("state").className = "down";
   }
 }
-function refreshThumb() { $("thumb").src = "/snapshot.png?w=480&t=" + Date.now(); }
+let snapshotOn = false;
+function refreshThumb() { if (snapshotOn) $("thumb").src = "/snapshot.png?w=480&t=" + Date.now(); }
 $("token").value = localStorage.getItem("basalt-token") || "";
 for (const b of document.querySelectorAll("[data-control]")) {
   b.addEventListener("click", async () => {

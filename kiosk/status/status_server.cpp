@@ -3,7 +3,9 @@
 
 #include "kiosk/status/status_server.h"
 
+#include <arpa/inet.h>
 #include <httplib.h>
+#include <netinet/in.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -12,6 +14,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -38,6 +41,66 @@ std::string trim(std::string s) {
   std::size_t start = 0;
   while (start < s.size() && std::isspace(static_cast<unsigned char>(s[start]))) ++start;
   return s.substr(start);
+}
+
+/// The token in `file` (surrounding white space trimmed), or "" when it cannot be read or is
+/// shorter than 16 characters.
+std::string tokenIn(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) return {};
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string token = trim(text.str());
+  return token.size() >= 16 ? token : std::string();
+}
+
+/// True for a loopback peer: 127.0.0.0/8, ::1, or 127.x mapped into IPv6.
+bool loopbackPeer(const std::string& address) {
+  in_addr v4{};
+  if (::inet_pton(AF_INET, address.c_str(), &v4) == 1) return (ntohl(v4.s_addr) >> 24) == 127;
+  in6_addr v6{};
+  if (::inet_pton(AF_INET6, address.c_str(), &v6) != 1) return false;
+  if (IN6_IS_ADDR_LOOPBACK(&v6)) return true;
+  return IN6_IS_ADDR_V4MAPPED(&v6) && v6.s6_addr[12] == 127;
+}
+
+/// Standard base64 (RFC 4648, section 4), padding optional; empty when `text` is not base64.
+std::optional<std::string> fromBase64(std::string_view text) {
+  while (!text.empty() && text.back() == '=') text.remove_suffix(1);
+  std::string out;
+  std::uint32_t bits = 0;
+  int count = 0;
+  for (const char c : text) {
+    int value = -1;
+    if (c >= 'A' && c <= 'Z') value = c - 'A';
+    if (c >= 'a' && c <= 'z') value = c - 'a' + 26;
+    if (c >= '0' && c <= '9') value = c - '0' + 52;
+    if (c == '+') value = 62;
+    if (c == '/') value = 63;
+    if (value < 0) return std::nullopt;
+    bits = (bits << 6) | static_cast<std::uint32_t>(value);
+    count += 6;
+    if (count >= 8) {
+      count -= 8;
+      out += static_cast<char>((bits >> count) & 0xff);
+    }
+  }
+  return out;
+}
+
+/// The secret a request gives: `Bearer SECRET`, or HTTP Basic with any user name and SECRET as
+/// the password (what a browser sends after asking for it).
+std::string credential(const httplib::Request& req) {
+  const std::string auth = req.get_header_value("Authorization");
+  if (auth.starts_with("Bearer ")) return auth.substr(7);
+  if (auth.starts_with("Basic ")) {
+    const auto pair = fromBase64(trim(auth.substr(6)));
+    if (pair) {
+      const auto colon = pair->find(':');
+      if (colon != std::string::npos) return pair->substr(colon + 1);
+    }
+  }
+  return {};
 }
 
 /// Compares in a time that does not depend on where the strings differ.
@@ -219,19 +282,25 @@ ServerCounters StatusServer::counters() const {
 Result<std::unique_ptr<StatusServer>> StatusServer::start(const StatusSpec& spec, StatusBoard& board) {
   std::string token = spec.token;
   if (token.empty() && !spec.tokenFile.empty()) {
-    std::ifstream in(spec.tokenFile);
-    if (in) {
-      std::ostringstream text;
-      text << in.rdbuf();
-      token = trim(text.str());
-    }
-    if (token.size() < 16) {
+    token = tokenIn(spec.tokenFile);
+    if (token.empty()) {
       log::warn(kLogStatus, "the token file {} is missing or shorter than 16 characters; controls are off",
                 spec.tokenFile);
-      token.clear();
     }
   }
   auto server = std::unique_ptr<StatusServer>(new StatusServer(spec, board, std::move(token)));
+  if (!spec.readToken.empty() || !spec.readTokenFile.empty()) {
+    server->readGuarded_ = true;
+    server->readToken_ = spec.readToken.empty() ? tokenIn(spec.readTokenFile) : spec.readToken;
+    if (server->readToken_.empty()) {
+      // Fail closed: a missing read token keeps other machines out rather than letting them in.
+      server->readTokenProblem_ = fmt::format(
+          "the read token file {} is missing or shorter than 16 characters; only this machine can read the status "
+          "until it is there (then restart Basalt)",
+          spec.readTokenFile);
+      log::warn(kLogStatus, "{}", server->readTokenProblem_);
+    }
+  }
   server->routes();
   httplib::Server& http = *server->server_;
   http.new_task_queue = [] { return new httplib::ThreadPool(2); };
@@ -274,6 +343,25 @@ void StatusServer::routes() {
       replyJson(res, 429, false, fmt::format("too many requests: at most {} a second", spec_.requestsPerSecond));
       return httplib::Server::HandlerResponse::Handled;
     }
+    // Reading from another machine may need the read token (controls check theirs).
+    if (readGuarded_ && (req.method == "GET" || req.method == "HEAD") && !loopbackPeer(req.remote_addr)) {
+      if (readToken_.empty()) {
+        rejectedAuth_.fetch_add(1, std::memory_order_relaxed);
+        replyJson(res, 403, false, readTokenProblem_);
+        return httplib::Server::HandlerResponse::Handled;
+      }
+      const std::string given = credential(req);
+      if (!sameSecret(readToken_, given) && !sameSecret(token_, given)) {
+        rejectedAuth_.fetch_add(1, std::memory_order_relaxed);
+        // Basic, so that a browser asks for it: any user name, the read token as the password.
+        res.set_header("WWW-Authenticate", "Basic realm=\"Basalt status\", charset=\"UTF-8\"");
+        replyJson(res, 401, false,
+                  given.empty() ? "reading the status from another machine needs the read token: 'Authorization: "
+                                  "Bearer TOKEN', or any user name with the token as the password"
+                                : "wrong read token");
+        return httplib::Server::HandlerResponse::Handled;
+      }
+    }
     return httplib::Server::HandlerResponse::Unhandled;
   });
   http.set_error_handler([this](const httplib::Request& req, httplib::Response& res) {
@@ -293,7 +381,9 @@ void StatusServer::routes() {
   const auto now = [] { return SystemClock().wallNow(); };
   http.Get("/health", [this, now](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
-    res.set_content(healthJson(board_.snapshot(now())), "application/json");
+    StatusSnapshot snapshot = board_.snapshot(now());
+    snapshot.server = facts();
+    res.set_content(healthJson(snapshot), "application/json");
   });
   http.Get("/metrics", [this, now](const httplib::Request&, httplib::Response& res) {
     StatusSnapshot snapshot = board_.snapshot(now());
@@ -305,6 +395,11 @@ void StatusServer::routes() {
     res.set_content(std::string(statusPageHtml()), "text/html; charset=utf-8");
   });
   http.Get("/snapshot.png", [this](const httplib::Request& req, httplib::Response& res) {
+    if (!spec_.snapshot) {
+      // A camera show may not want its visitors seen by whoever reaches the port.
+      replyJson(res, 403, false, "the snapshot is off in this show ([status] snapshot = false in show.toml)");
+      return;
+    }
     std::uint32_t width = 0;
     if (req.has_param("w")) {
       const std::string w = req.get_param_value("w");

@@ -2,9 +2,10 @@
 
 /// \file
 /// \brief The status and control server: GET /health (JSON), /metrics (Prometheus text),
-/// /snapshot.png (the frame on screen now) and / (a status page for a phone); POST
-/// /control/{next,previous,reload,command,restart-device} with a bearer token. Loopback only
-/// unless the manifest opens it; request sizes and rates are limited.
+/// /snapshot.png (the frame on screen now, unless the show turns it off) and / (a status page
+/// for a phone); POST /control/{next,previous,reload,command,restart-device,calibrate} with a
+/// bearer token. Loopback only unless the manifest opens it, and then GETs from other machines
+/// may need a read token; request sizes and rates are limited.
 
 #include <atomic>
 #include <condition_variable>
@@ -56,6 +57,8 @@ class StatusServer {
   [[nodiscard]] ServerCounters counters() const;
   /// \brief True when POST controls are on (a token is configured and readable).
   [[nodiscard]] bool controlsEnabled() const { return !token_.empty(); }
+  /// \brief What the page shows and hides.
+  [[nodiscard]] ServerFacts facts() const { return {controlsEnabled(), spec_.snapshot, readGuarded_}; }
 
   class Limiter;
 
@@ -71,6 +74,11 @@ class StatusServer {
   StatusSpec spec_;
   StatusBoard& board_;
   std::string token_;
+  // GETs from other machines need a token: readToken_ (or token_); none is readable when
+  // readToken_ is empty, and readTokenProblem_ says why.
+  bool readGuarded_ = false;
+  std::string readToken_;
+  std::string readTokenProblem_;
   std::unique_ptr<httplib::Server> server_;
   std::unique_ptr<Limiter> limiter_;
   std::thread thread_;

@@ -574,6 +574,44 @@ TEST(ManifestErrors, StatusServerStaysOnLoopbackWithoutAToken) {
   EXPECT_FALSE(ok.manifest->status.loopbackOnly());
 }
 
+// Makes sure the read token and the snapshot switch are read and checked like the other
+// [status] keys: misspelt keys get a suggestion, a short token is refused, a read token on a
+// loopback-only server is said to do nothing. Example failure: `snapshot = flase` ignored, and
+// a camera show's visitors visible to anyone on the network.
+TEST(ManifestErrors, StatusReadTokenAndSnapshot) {
+  ShowFolder f("status-read");
+  const auto typo =
+      f.read("[status]\nlisten = \"0.0.0.0:8180\"\ntoken_file = \"token\"\nread_tokn = \"x\"\nsnapshots = false\n");
+  EXPECT_TRUE(hasError(typo, 4, "status.read_tokn: unknown key; did you mean 'read_token'?")) << typo.text;
+  EXPECT_TRUE(hasError(typo, 5, "status.snapshots: unknown key; did you mean 'snapshot'?")) << typo.text;
+  const auto shortToken = f.read("[status]\nread_token = \"abc\"\n");
+  EXPECT_TRUE(hasError(shortToken, 2, "status.read_token: at least 16 characters")) << shortToken.text;
+  const auto notABool = f.read("[status]\nsnapshot = \"no\"\n");
+  EXPECT_FALSE(notABool.manifest) << notABool.text;
+  EXPECT_TRUE(hasError(notABool, 2, "snapshot")) << notABool.text;
+  const auto both = f.read(
+      "[status]\nlisten = \"0.0.0.0:8180\"\ntoken_file = \"token\"\nread_token = \"0123456789abcdef\"\n"
+      "read_token_file = \"read\"\n");
+  EXPECT_TRUE(hasError(both, 5, "give read_token or read_token_file, not both")) << both.text;
+  EXPECT_TRUE(hasWarning(both, 5, "status.read_token_file: 'read' does not exist yet")) << both.text;
+  const auto loopback = f.read("[status]\nread_token = \"0123456789abcdef\"\n");
+  ASSERT_TRUE(loopback.manifest) << loopback.text;
+  EXPECT_TRUE(hasWarning(loopback, 2, "only this machine reaches")) << loopback.text;
+
+  writeFile(f.dir / "token", "0123456789abcdef0123456789abcdef\n");
+  writeFile(f.dir / "read", "fedcba9876543210fedcba9876543210\n");
+  const auto ok = f.read(
+      "[status]\nlisten = \"0.0.0.0:8180\"\ntoken_file = \"token\"\nread_token_file = \"read\"\nsnapshot = false\n");
+  ASSERT_TRUE(ok.manifest) << ok.text;
+  EXPECT_TRUE(fs::equivalent(ok.manifest->status.readTokenFile, f.dir / "read"));
+  EXPECT_FALSE(ok.manifest->status.snapshot);
+  EXPECT_FALSE(hasWarning(ok, 4, "")) << ok.text;
+  const auto plain = f.read("[status]\n");
+  ASSERT_TRUE(plain.manifest);
+  EXPECT_TRUE(plain.manifest->status.snapshot) << "on unless the show turns it off";
+  EXPECT_TRUE(plain.manifest->status.readToken.empty());
+}
+
 TEST(ManifestErrors, OutputsAndViews) {
   ShowFolder f("output");
   const auto r = f.read(

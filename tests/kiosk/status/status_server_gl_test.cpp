@@ -532,5 +532,27 @@ TEST_F(StatusServer, PageRendersInABrowser) {
   EXPECT_GT(cube, 200u) << "the thumbnail of the frame on screen";
 }
 
+// Makes sure a show with `[status] snapshot = false` serves no picture and its page shows none:
+// the thumbnail is hidden and a note says why. Example failure: a broken-image icon, or the
+// camera's visitors on the page after all.
+TEST(StatusServerSnapshotOff, ThePageHidesTheThumbnail) {
+  std::string why;
+  if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  if (::access("/usr/bin/chromium", X_OK) != 0) GTEST_SKIP() << "chromium is not installed";
+  std::string manifest = showManifest(true) + "snapshot = false\n";
+  const auto dir = test::writeShow("status-snapshot-off", manifest);
+  std::ofstream(dir / "token") << kToken << "\n";
+  auto show = test::RunningShow::start({(dir / "show.toml").string(), "--realtime", "--no-resume"}, {}, why);
+  ASSERT_TRUE(show) << why;
+  const auto refused = show->get("/snapshot.png");
+  EXPECT_EQ(refused.status, 403);
+  EXPECT_NE(refused.body.find("snapshot is off"), std::string::npos) << refused.body;
+  const auto dom = chromium("http://127.0.0.1:" + std::to_string(show->port()) + "/", {"--dump-dom"});
+  ASSERT_EQ(dom.exitCode, 0) << dom.output;
+  EXPECT_NE(dom.output.find("<img id=\"thumb\" alt=\"the frame on screen now\" hidden=\"\">"), std::string::npos)
+      << dom.output;
+  EXPECT_NE(dom.output.find("<p id=\"snapshot-off\">The snapshot is off"), std::string::npos) << dom.output;
+}
+
 }  // namespace
 }  // namespace basalt

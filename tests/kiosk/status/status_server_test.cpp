@@ -10,6 +10,8 @@
 #include <httplib.h>
 
 #include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <net/if.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -18,6 +20,8 @@
 #include <atomic>
 #include <chrono>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 
 #include "kiosk/status/status_board.h"
 #include "kiosk/status/status_server.h"
@@ -271,6 +275,113 @@ TEST(StatusServerPost, ARefusedBodyDoesNotSpoilTheConnection) {
   ASSERT_TRUE(health);
   EXPECT_EQ(health->status, 200);
   EXPECT_EQ((*server)->counters().requests, 2u);
+}
+
+/// An IPv4 address of this machine other than loopback, or "" when it has none.
+std::string otherAddress() {
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) != 0) return {};
+  std::string found;
+  for (const ifaddrs* a = list; a && found.empty(); a = a->ifa_next) {
+    if (!a->ifa_addr || a->ifa_addr->sa_family != AF_INET || (a->ifa_flags & IFF_LOOPBACK) ||
+        !(a->ifa_flags & IFF_UP)) {
+      continue;
+    }
+    char text[INET_ADDRSTRLEN] = {};
+    ::inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(a->ifa_addr)->sin_addr, text, sizeof text);
+    found = text;
+  }
+  ::freeifaddrs(list);
+  return found;
+}
+
+httplib::Result getFrom(const std::string& host, std::uint16_t port, const std::string& path,
+                        const httplib::Headers& headers = {}) {
+  httplib::Client client(host, port);
+  client.set_connection_timeout(2, 0);
+  client.set_read_timeout(5, 0);
+  return client.Get(path, headers);
+}
+
+// Makes sure a read token keeps other machines from reading the status while this machine reads
+// freely, and that a browser is asked for it (HTTP Basic, any user name, the token as password).
+// Example failures: the page and snapshots open to the whole network; a local health check that
+// suddenly needs a token; a wrong token let through.
+TEST(StatusServerRead, OtherMachinesNeedTheReadToken) {
+  const std::string address = otherAddress();
+  if (address.empty()) GTEST_SKIP() << "this machine has no address but loopback to be reached from";
+  StatusBoard board(WallTime{}, 30);
+  StatusSpec s = spec(0);
+  s.host = "0.0.0.0";
+  s.readToken = "fedcba9876543210fedcba9876543210";
+  auto server = StatusServer::start(s, board);
+  ASSERT_TRUE(server) << server.error().describe();
+  const std::uint16_t port = (*server)->port();
+  EXPECT_EQ(getFrom("127.0.0.1", port, "/health")->status, 200) << "this machine reads without a token";
+  for (const char* path : {"/health", "/metrics", "/", "/snapshot.png", "/nowhere"}) {
+    const auto refused = getFrom(address, port, path);
+    ASSERT_TRUE(refused) << path;
+    EXPECT_EQ(refused->status, 401) << path << ": " << refused->body;
+    EXPECT_EQ(refused->get_header_value("WWW-Authenticate"), "Basic realm=\"Basalt status\", charset=\"UTF-8\"");
+    EXPECT_TRUE(has(refused->body, "needs the read token")) << refused->body;
+  }
+  const auto bearer = getFrom(address, port, "/health", {{"Authorization", "Bearer " + s.readToken}});
+  EXPECT_EQ(bearer->status, 200) << bearer->body;
+  // "any:fedcba9876543210fedcba9876543210" in base64, as a browser sends it.
+  const auto basic =
+      getFrom(address, port, "/metrics", {{"Authorization", "Basic YW55OmZlZGNiYTk4NzY1NDMyMTBmZWRjYmE5ODc2NTQzMjEw"}});
+  EXPECT_EQ(basic->status, 200) << basic->body;
+  const auto control = getFrom(address, port, "/health", {{"Authorization", std::string("Bearer ") + kToken}});
+  EXPECT_EQ(control->status, 200) << "the control token reads too";
+  const auto wrong = getFrom(address, port, "/health", {{"Authorization", "Bearer fedcba9876543210fedcba987654321X"}});
+  EXPECT_EQ(wrong->status, 401);
+  EXPECT_TRUE(has(wrong->body, "wrong read token")) << wrong->body;
+  const auto health = nlohmann::json::parse(bearer->body);
+  EXPECT_EQ(health["server"]["read_token"], true) << bearer->body;
+  // curl's -u, the way a technician types it.
+  if (::access("/usr/bin/curl", X_OK) == 0) {
+    const auto curl =
+        test::run({"/usr/bin/curl", "-sS", "--max-time", "4", "-o", "/dev/null", "-w", "%{http_code}", "-u",
+                   "technician:" + s.readToken, "http://" + address + ":" + std::to_string(port) + "/health"});
+    EXPECT_EQ(curl.output, "200") << curl.output;
+  }
+}
+
+// Makes sure a read token file that is missing keeps other machines out (fail closed) and says
+// why. Example failure: a typo in the file's name that opens the status to everyone.
+TEST(StatusServerRead, AMissingReadTokenFileKeepsOthersOut) {
+  const std::string address = otherAddress();
+  if (address.empty()) GTEST_SKIP() << "this machine has no address but loopback to be reached from";
+  StatusBoard board(WallTime{}, 30);
+  StatusSpec s = spec(0);
+  s.host = "0.0.0.0";
+  s.readTokenFile = test::scratchDir("status-read-token") / "missing";
+  auto server = StatusServer::start(s, board);
+  ASSERT_TRUE(server) << server.error().describe();
+  const auto refused = getFrom(address, (*server)->port(), "/health", {{"Authorization", "Bearer anything"}});
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 403);
+  EXPECT_TRUE(has(refused->body, "the read token file")) << refused->body;
+  EXPECT_TRUE(has(refused->body, "missing")) << refused->body;
+  EXPECT_EQ(getFrom("127.0.0.1", (*server)->port(), "/health")->status, 200);
+}
+
+// Makes sure a show can turn the snapshot off: a clear refusal, and /health tells the page to
+// hide the thumbnail. Example failure: a camera show's visitors served to whoever asks.
+TEST(StatusServerRead, TheSnapshotCanBeTurnedOff) {
+  StatusBoard board(WallTime{}, 30);
+  StatusSpec s = spec(0);
+  s.snapshot = false;
+  auto server = StatusServer::start(s, board);
+  ASSERT_TRUE(server) << server.error().describe();
+  std::string body;
+  EXPECT_EQ(get((*server)->port(), "/snapshot.png?w=100", &body), 403);
+  EXPECT_TRUE(has(body, "the snapshot is off in this show ([status] snapshot = false")) << body;
+  EXPECT_EQ(board.snapshotRequests().size(), 0u) << "nothing asked of the frame loop";
+  ASSERT_EQ(get((*server)->port(), "/health", &body), 200);
+  const auto health = nlohmann::json::parse(body);
+  EXPECT_EQ(health["server"]["snapshot"], false) << body;
+  EXPECT_EQ(health["server"]["controls"], true) << body;
 }
 
 }  // namespace
