@@ -574,6 +574,7 @@ int runShow(const RunOptions& options) {
   std::optional<ResumePoint> resume;
   if (options.manifest && manifest.kiosk.resume && options.resume) {
     const std::filesystem::path folder = options.stateDir ? *options.stateDir : defaultStateFolder();
+    board.watchFolder("state", folder);  // the status page shows its free space
     auto store = StateStore::open(folder, manifest.file.string());
     if (store) {
       state = std::move(*store);

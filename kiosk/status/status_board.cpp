@@ -201,6 +201,8 @@ FrameFigures StatusBoard::frameFigures() const {
   return f;
 }
 
+std::vector<log::Record> StatusBoard::logRecords() const { return ring_->snapshot(); }
+
 StatusSnapshot StatusBoard::snapshot(WallTime now) const {
   StatusSnapshot s;
   s.now = now;

@@ -122,8 +122,9 @@ struct StatusSnapshot {
   runtime::PerformanceMeter performance;  ///< LAVA's meter, as last sampled (updates == 0: not yet)
   std::optional<FrameLockFigures> lock;   ///< a frame-locked node's figures ([lock]); none otherwise
   // Filled by the status server when it reports, not by the board:
-  std::optional<ProcessFigures> process;  ///< the process's own figures (/metrics)
+  std::optional<ProcessFigures> process;  ///< the process's own figures
   std::optional<ServerFacts> server;      ///< the server's set-up (/health)
+  std::optional<MachineFacts> machine;    ///< the machine's facts (/health)
 };
 
 /// \brief A request from the control server to the frame loop, answered through `reply`.
@@ -198,6 +199,14 @@ class StatusBoard {
   BoundedQueue<std::shared_ptr<SnapshotRequest>>& snapshotRequests() { return snapshots_; }
   /// \brief The show's Clock, whose calendar time the schedule is read in (any thread reads it).
   void setShowClock(const Clock& clock) { showClock_ = &clock; }
+  /// \brief A folder whose file system's free space the page shows ("state"); set before the
+  /// server starts. The show's own folder is added by the server.
+  void watchFolder(std::string name, std::filesystem::path path) {
+    folders_.push_back({std::move(name), std::move(path)});
+  }
+  [[nodiscard]] const std::vector<FolderToWatch>& watchedFolders() const { return folders_; }
+  /// \brief Every record the log ring holds (the last `logCapacity`), oldest first.
+  [[nodiscard]] std::vector<log::Record> logRecords() const;
   /// \brief Set by the run to wake the frame loop when a request arrives.
   void setWake(std::function<void()> wake);
   void wake() const;
@@ -237,6 +246,7 @@ class StatusBoard {
   std::string lastReload_;                  // guarded by mutex_
   std::function<void()> wake_;              // set before the server starts
   const Clock* showClock_ = nullptr;        // set before the server starts
+  std::vector<FolderToWatch> folders_;      // set before the server starts
   std::shared_ptr<log::RingSink> ring_;
   std::shared_ptr<CountingSink> counter_;
   BoundedQueue<ControlRequest> controls_{16};

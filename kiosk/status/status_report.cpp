@@ -232,7 +232,47 @@ std::string healthJson(const StatusSnapshot& s) {
   if (const std::optional<ServerFacts>& server = s.server) {
     out["server"] = {{"controls", server->controls}, {"snapshot", server->snapshot}, {"read_token", server->readToken}};
   }
+  const BuildInfo build = buildInfo();
+  out["build"] = {{"version", build.version}, {"revision", build.revision}, {"build", build.build}};
+  if (const std::optional<ProcessFigures>& p = s.process) {
+    out["process"] = {
+        {"resident_bytes", p->residentBytes}, {"open_fds", p->openFds}, {"cpu_seconds", rounded(p->cpuSeconds, 2)}};
+  }
+  if (const std::optional<MachineFacts>& machine = s.machine) {
+    Json addresses = Json::array();
+    for (const NetworkAddress& a : machine->addresses)
+      addresses.push_back({{"interface", a.interface}, {"address", a.address}});
+    Json disks = Json::array();
+    for (const DiskFacts& d : machine->disks) {
+      disks.push_back({{"name", d.name},
+                       {"path", d.path},
+                       {"total_bytes", d.totalBytes},
+                       {"free_bytes", d.freeBytes},
+                       {"error", d.error.empty() ? Json() : Json(d.error)}});
+    }
+    Json temperature;  // null: no sensor
+    if (machine->cpuTemperature) {
+      temperature = {{"celsius", rounded(machine->cpuTemperature->celsius, 1)},
+                     {"sensor", machine->cpuTemperature->sensor}};
+    }
+    out["machine"] = {
+        {"hostname", machine->hostname},
+        {"addresses", std::move(addresses)},
+        {"uptime_seconds", rounded(machine->uptimeSeconds, 0)},
+        {"memory", {{"total_bytes", machine->memoryTotalBytes}, {"available_bytes", machine->memoryAvailableBytes}}},
+        {"disks", std::move(disks)},
+        {"cpu_temperature", std::move(temperature)}};
+  }
   return dumpJson(out, 2) + "\n";
+}
+
+std::string logText(const std::vector<log::Record>& records) {
+  std::string out;
+  for (const log::Record& r : records) {
+    out += logLine(r);
+    out += '\n';
+  }
+  return out;
 }
 
 std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
@@ -464,42 +504,78 @@ std::string_view statusPageHtml() {
 <title>Basalt status</title>
 <style>
   :root { color-scheme: dark; }
-  body { margin: 0; font: 16px/1.4 system-ui, sans-serif; background: #15171c; color: #e8e8e8; }
-  header { padding: 12px 16px; background: #20242c; display: flex; align-items: center; gap: 12px; }
-  header h1 { font-size: 20px; margin: 0; flex: 1; }
+  body { margin: 0; font: 15px/1.4 system-ui, sans-serif; background: #15171c; color: #e8e8e8; }
+  header { padding: 12px 16px; background: #20242c; display: flex; align-items: center; gap: 12px; flex-wrap: wrap; }
+  header h1 { font-size: 20px; margin: 0; flex: 1; min-width: 8em; }
+  #version { color: #9fb3c8; font-size: 13px; }
   #state { padding: 4px 10px; border-radius: 12px; font-weight: 600; background: #555; }
   #state.ok { background: #1f8a3a; }
   #state.degraded { background: #c27c0e; }
   #state.down { background: #b3261e; }
-  main { padding: 12px 16px; display: grid; gap: 14px; }
-  section { background: #1d2027; border-radius: 10px; padding: 12px; }
+  .notice { margin: 12px 16px 0; padding: 10px 12px; border-radius: 8px; background: #3a2e12; color: #f3d49b;
+            border: 1px solid #6b531c; }
+  main { padding: 12px 16px; display: grid; gap: 14px; grid-template-columns: minmax(0, 1fr); align-items: start; }
+  @media (min-width: 900px) { main { grid-template-columns: repeat(2, minmax(0, 1fr)); } .wide { grid-column: 1 / -1; } }
+  @media (min-width: 1400px) { main { grid-template-columns: repeat(3, minmax(0, 1fr)); } }
+  section { background: #1d2027; border-radius: 10px; padding: 12px; min-width: 0; }
   h2 { font-size: 15px; margin: 0 0 8px; color: #9fb3c8; text-transform: uppercase; letter-spacing: .05em; }
   #thumb { width: 100%; max-width: 480px; background: #000; border-radius: 6px; display: block; }
+  #thumb[hidden] { display: none; }
   table { width: 100%; border-collapse: collapse; }
-  td { padding: 4px 6px; border-top: 1px solid #2c313b; vertical-align: top; }
-  .live, .playing { color: #5fd17a; } .absent, .lost, .waiting { color: #f0a030; }
+  td { padding: 4px 6px; border-top: 1px solid #2c313b; vertical-align: top; overflow-wrap: break-word; }
+  td.nowrap { white-space: nowrap; }
+  .device { border-top: 1px solid #2c313b; padding: 6px 2px; }
+  .device .head { display: flex; flex-wrap: wrap; gap: 4px 10px; align-items: baseline; }
+  .device .name { font-weight: 600; }
+  .device .since { color: #9aa3ad; margin-left: auto; white-space: nowrap; }
+  .device .message { color: #c3c9d2; font-size: 14px; overflow-wrap: break-word; }
+  .device button { padding: 2px 10px; font-size: 13px; }
+  .live, .playing, .ok { color: #5fd17a; } .absent, .lost, .waiting, .warning { color: #f0a030; }
+  .error, .fatal { color: #ff8a80; } .idle, .muted { color: #9aa3ad; }
+  dl.facts { display: grid; grid-template-columns: max-content minmax(0, 1fr); gap: 4px 12px; margin: 0; }
+  dl.facts dt { color: #9fb3c8; } dl.facts dd { margin: 0; overflow-wrap: break-word; min-width: 0; }
   #log { font: 12px/1.35 ui-monospace, monospace; white-space: pre-wrap; max-height: 240px; overflow: auto; }
-  .figures { display: grid; grid-template-columns: repeat(auto-fit, minmax(120px, 1fr)); gap: 8px; }
+  .figures { display: grid; grid-template-columns: repeat(auto-fit, minmax(110px, 1fr)); gap: 8px; }
   .figure b { display: block; font-size: 22px; }
   form { display: flex; flex-wrap: wrap; gap: 8px; }
   input, button { font: inherit; padding: 8px 12px; border-radius: 6px; border: 1px solid #3a404c; background: #262a33; color: inherit; }
+  td button { padding: 2px 10px; font-size: 13px; }
+  button:disabled { opacity: .45; }
+  a { color: #8ab4f8; }
   #answer { min-height: 1.4em; }
 </style>
 </head>
 <body>
-<header><h1 id="show">Basalt</h1><span id="state">…</span></header>
+<header><h1 id="show">Basalt</h1><span id="version"></span><span id="state">…</span></header>
+<p class="notice" id="controls-off" hidden>Controls are off: this show has no token. Set <code>token_file</code>
+  under <code>[status]</code> in show.toml to use the buttons on this page.</p>
+<p class="notice" id="unreachable" hidden>Basalt does not answer: the figures below are the last it gave.</p>
 <main>
   <section><h2>On screen</h2><img id="thumb" alt="the frame on screen now" hidden>
     <p id="snapshot-off" hidden>The snapshot is off in this show ([status] snapshot = false).</p>
     <p id="item"></p></section>
+  <section><h2>This machine</h2><dl class="facts">
+    <dt>Basalt</dt><dd id="build">–</dd>
+    <dt>Host name</dt><dd id="hostname">–</dd>
+    <dt>Addresses</dt><dd id="addresses">–</dd>
+    <dt>Up</dt><dd id="uptimes">–</dd>
+    <dt>Disk</dt><dd id="disk">–</dd>
+    <dt>Memory</dt><dd id="memory">–</dd>
+    <dt>CPU temperature</dt><dd id="temperature">–</dd></dl></section>
+  <section><h2>Devices</h2><div id="devices"></div></section>
   <section><h2>Frames</h2><div class="figures">
     <div class="figure"><b id="fps">–</b>frames per second</div>
     <div class="figure"><b id="p99">–</b>ms frame time (99%)</div>
     <div class="figure"><b id="late">–</b>late frames</div>
+    <div class="figure"><b id="dropped">–</b>dropped frames</div>
     <div class="figure"><b id="uptime">–</b>up</div></div></section>
-  <section><h2>Devices</h2><table id="devices"></table></section>
+  <section><h2>Last errors</h2><table id="errors"></table></section>
   <section><h2>Streams</h2><table id="streams"></table></section>
-  <section><h2>Log</h2><div id="log"></div></section>
+  <section><h2>Frame lock</h2><dl class="facts" id="lock"></dl></section>
+  <section class="wide"><h2>Log</h2>
+    <p><a id="log-download" href="/log.txt" download="basalt.log">Download the log</a>
+      <span class="muted">(the records Basalt keeps; the journal has the rest: journalctl -u basalt)</span></p>
+    <div id="log"></div></section>
   <section><h2>Controls</h2>
     <form id="controls" onsubmit="return false">
       <input id="token" type="password" placeholder="token" autocomplete="current-password">
@@ -510,50 +586,104 @@ std::string_view statusPageHtml() {
 <script>
 "use strict";
 const $ = (id) => document.getElementById(id);
+let controlsOn = false;
+let snapshotOn = false;
 function text(s) { return document.createTextNode(s); }
+function cell(tr, value, cls) { const td = tr.insertCell(); td.append(value instanceof Node ? value : text(value)); if (cls) td.className = cls; return td; }
 function rows(table, items, cells) {
   table.replaceChildren();
-  if (!items.length) { const tr = table.insertRow(); tr.insertCell().append(text("none")); return; }
-  for (const item of items) {
-    const tr = table.insertRow();
-    for (const [value, cls] of cells(item)) { const td = tr.insertCell(); td.append(text(value)); if (cls) td.className = cls; }
+  if (!items.length) { cell(table.insertRow(), "none", "muted"); return; }
+  for (const item of items) { const tr = table.insertRow(); for (const [value, cls] of cells(item)) cell(tr, value, cls); }
+}
+function facts(dl, pairs) {
+  dl.replaceChildren();
+  for (const [name, value] of pairs) { const dt = document.createElement("dt"); dt.textContent = name; const dd = document.createElement("dd"); dd.textContent = value; dl.append(dt, dd); }
+}
+function duration(s) { return s < 120 ? Math.round(s) + " s" : s < 7200 ? Math.round(s / 60) + " min" : s < 172800 ? (s / 3600).toFixed(1) + " h" : (s / 86400).toFixed(1) + " days"; }
+function since(iso) { return duration(Math.max(0, (Date.now() - Date.parse(iso)) / 1000)); }
+function bytes(n) { const units = ["B", "kB", "MB", "GB", "TB"]; let i = 0; while (n >= 1000 && i < units.length - 1) { n /= 1000; ++i; } return (i ? n.toFixed(1) : n) + " " + units[i]; }
+function clock(iso) { return new Date(iso).toLocaleTimeString(); }
+function span(value, cls) { const e = document.createElement("span"); e.textContent = value; e.className = cls; return e; }
+function devices(list, items) {
+  list.replaceChildren();
+  if (!items.length) { list.append(span("none", "muted")); return; }
+  for (const d of items) {
+    const row = document.createElement("div"); row.className = "device";
+    const head = document.createElement("div"); head.className = "head";
+    head.append(span(d.name, "name"), span(d.state, d.state), span("for " + since(d.since), "since"), restartButton(d.name));
+    const message = document.createElement("div"); message.className = "message";
+    message.textContent = d.backend + (d.message ? " · " + d.message : "");
+    row.append(head, message);
+    list.append(row);
   }
 }
-function since(iso) { const s = Math.max(0, (Date.now() - Date.parse(iso)) / 1000); return s < 120 ? Math.round(s) + " s" : s < 7200 ? Math.round(s / 60) + " min" : Math.round(s / 3600) + " h"; }
-function duration(s) { return s < 120 ? Math.round(s) + " s" : s < 7200 ? Math.round(s / 60) + " min" : (s / 3600).toFixed(1) + " h"; }
+function restartButton(name) {
+  const b = document.createElement("button");
+  b.textContent = "Restart"; b.dataset.device = name; b.disabled = !controlsOn;
+  b.title = controlsOn ? "close and open " + name + " again" : "controls are off: this show has no token";
+  return b;
+}
+async function control(path, what) {
+  localStorage.setItem("basalt-token", $("token").value);
+  const r = await fetch(path, {method: "POST", headers: {"Authorization": "Bearer " + $("token").value}});
+  const a = await r.json().catch(() => ({message: r.statusText}));
+  $("answer").textContent = what + ": " + r.status + ": " + a.message;
+  refresh();
+}
 async function refresh() {
+  let h;
   try {
     const r = await fetch("/health", {cache: "no-store"});
-    const h = await r.json();
-    $("show").textContent = h.show.name || "Basalt";
-    $("state").textContent = h.state; $("state").className = h.state;
-    $("item").textContent = h.show.description + (h.show.next_schedule_change ? " · schedule changes " + new Date(h.show.next_schedule_change).toLocaleString() : "");
-    $("fps").textContent = h.frames.per_second.toFixed(1);
-    $("p99").textContent = h.frames.frame_time_ms.p99.toFixed(1);
-    $("late").textContent = h.frames.late;
-    $("uptime").textContent = duration(h.uptime_seconds);
-    rows($("devices"), h.devices, (d) => [[d.name], [d.state, d.state], [d.backend + (d.message ? " · " + d.message : "")], ["for " + since(d.since)]]);
-    rows($("streams"), h.streams, (s) => [[s.name], [s.state, s.state], [s.message]]);
-    $("log").textContent = h.log_tail.join("\n");
-    snapshotOn = !h.server || h.server.snapshot;
-    $("thumb").hidden = !snapshotOn; $("snapshot-off").hidden = snapshotOn;
-    if (snapshotOn && !$("thumb").getAttribute("src")) refreshThumb();
+    h = await r.json();
   } catch (e) {
-    $("state").textContent = "unreachable"; $("state").className = "down";
+    $("state").textContent = "unreachable"; $("state").className = "down"; $("unreachable").hidden = false;
+    return;
   }
+  $("unreachable").hidden = true;
+  const server = h.server || {controls: true, snapshot: true};
+  controlsOn = server.controls;
+  $("controls-off").hidden = controlsOn;
+  for (const b of document.querySelectorAll("#controls button")) b.disabled = !controlsOn;
+  $("show").textContent = h.show.name || "Basalt";
+  $("version").textContent = "Basalt " + h.build.version;
+  $("state").textContent = h.state; $("state").className = h.state;
+  $("item").textContent = h.show.description + (h.show.next_schedule_change ? " · schedule changes " + new Date(h.show.next_schedule_change).toLocaleString() : "");
+  $("fps").textContent = h.frames.per_second === null ? "–" : h.frames.per_second.toFixed(1);
+  $("p99").textContent = h.frames.frame_time_ms.p99 === null ? "–" : h.frames.frame_time_ms.p99.toFixed(1);
+  $("late").textContent = h.frames.late;
+  $("dropped").textContent = h.frames.dropped;
+  $("uptime").textContent = duration(h.uptime_seconds);
+  devices($("devices"), h.devices);
+  rows($("streams"), h.streams, (s) => [[s.name, "nowrap"], [s.state, s.state + " nowrap"], [s.message]]);
+  rows($("errors"), h.last_errors.slice().reverse(), (e) => [[clock(e.time), "nowrap"], [e.level, e.level + " nowrap"], [e.category + ": " + e.message]]);
+  const l = h.lock;
+  facts($("lock"), !l ? [["role", "not frame-locked (no [lock] in show.toml)"]] : l.role === "leader"
+    ? [["role", "leader '" + l.node + "'"], ["followers", l.followers + " of " + l.followers_known], ["barrier time-outs", l.barrier_timeouts], ["wait for answers", l.barrier_wait_ms.p50 + " ms (max " + l.barrier_wait_ms.max + ")"], ["followers dropped / rejoined", l.followers_dropped + " / " + l.followers_rejoined]]
+    : [["role", "follower '" + l.node + "'"], ["leader", l.leader_present ? "present" : "lost" + (l.holding ? ", holding frame " + l.held_frame + " for " + duration(l.holding_seconds) : "")], ["skipped / presents missed", l.skipped + " / " + l.presents_missed], ["clock offset", l.clock_offset_us + " µs"], ["delay", l.delay_ms.p50 + " ms (max " + l.delay_ms.max + ")"], ["leader lost / returned", l.leader_lost + " / " + l.leader_returned]]);
+  $("build").textContent = h.build.version + ", revision " + h.build.revision + " (" + h.build.build + ")";
+  const m = h.machine;
+  if (m) {
+    $("hostname").textContent = m.hostname;
+    $("addresses").textContent = m.addresses.length ? m.addresses.map((a) => a.address + " (" + a.interface + ")").join(", ") : "none but loopback";
+    $("uptimes").textContent = "Basalt " + duration(h.uptime_seconds) + " · machine " + duration(m.uptime_seconds);
+    $("disk").textContent = m.disks.length ? m.disks.map((d) => d.name + ": " + (d.error ? "unreadable (" + d.error + ")" : bytes(d.free_bytes) + " free of " + bytes(d.total_bytes)) + " (" + d.path + ")").join("; ") : "no folder to watch";
+    $("memory").textContent = bytes(m.memory.available_bytes) + " available of " + bytes(m.memory.total_bytes) + (h.process ? " · Basalt uses " + bytes(h.process.resident_bytes) : "");
+    $("temperature").textContent = m.cpu_temperature ? m.cpu_temperature.celsius.toFixed(1) + " °C (" + m.cpu_temperature.sensor + ")" : "no sensor";
+  }
+  $("log").textContent = h.log_tail.join("\n");
+  snapshotOn = server.snapshot;
+  $("thumb").hidden = !snapshotOn; $("snapshot-off").hidden = snapshotOn;
+  if (snapshotOn && !$("thumb").getAttribute("src")) refreshThumb();
 }
-let snapshotOn = false;
 function refreshThumb() { if (snapshotOn) $("thumb").src = "/snapshot.png?w=480&t=" + Date.now(); }
 $("token").value = localStorage.getItem("basalt-token") || "";
 for (const b of document.querySelectorAll("[data-control]")) {
-  b.addEventListener("click", async () => {
-    localStorage.setItem("basalt-token", $("token").value);
-    const r = await fetch("/control/" + b.dataset.control, {method: "POST", headers: {"Authorization": "Bearer " + $("token").value}});
-    const a = await r.json().catch(() => ({message: r.statusText}));
-    $("answer").textContent = r.status + ": " + a.message;
-    refresh();
-  });
+  b.addEventListener("click", () => control("/control/" + b.dataset.control, b.dataset.control));
 }
+$("devices").addEventListener("click", (e) => {
+  const b = e.target.closest("button[data-device]");
+  if (b) control("/control/restart-device?device=" + encodeURIComponent(b.dataset.device), "restart " + b.dataset.device);
+});
 refresh();
 setInterval(refresh, 2000);
 setInterval(refreshThumb, 5000);

@@ -25,8 +25,12 @@ struct ServerCounters {
 std::string_view overallState(const StatusSnapshot& s);
 
 /// \brief GET /health: state, uptime, show and item, frame figures, devices, streams, reloads,
-/// the last errors.
+/// the last errors, the log's tail; the build, and what the server filled in: the process, the
+/// machine, the server's set-up.
 std::string healthJson(const StatusSnapshot& s);
+
+/// \brief GET /log.txt: the log records the board keeps, one line each, oldest first.
+std::string logText(const std::vector<log::Record>& records);
 
 /// \brief GET /metrics in the Prometheus text format (version 0.0.4): the same figures.
 std::string metricsText(const StatusSnapshot& s, const ServerCounters& server);

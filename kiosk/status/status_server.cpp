@@ -275,6 +275,20 @@ std::string StatusServer::url() const {
   return fmt::format("http://{}{}{}:{}/", v6 ? "[" : "", spec_.host, v6 ? "]" : "", port());
 }
 
+MachineFacts StatusServer::machineFacts(const std::string& manifest) {
+  const Nanos now = SystemClock().now();
+  std::lock_guard lock(machineMutex_);
+  // Read at most once a second, however often the page and the scrapers ask.
+  if (!machine_ || now - machineRead_ >= std::chrono::seconds(1)) {
+    std::vector<FolderToWatch> folders;
+    if (!manifest.empty()) folders.push_back({"show", std::filesystem::path(manifest).parent_path()});
+    for (const FolderToWatch& f : board_.watchedFolders()) folders.push_back(f);
+    machine_ = readMachineFacts(folders);
+    machineRead_ = now;
+  }
+  return *machine_;
+}
+
 ServerCounters StatusServer::counters() const {
   return {requests_.load(), rejectedRate_.load(), rejectedAuth_.load(), rejectedSize_.load()};
 }
@@ -383,7 +397,14 @@ void StatusServer::routes() {
     res.set_header("Cache-Control", "no-store");
     StatusSnapshot snapshot = board_.snapshot(now());
     snapshot.server = facts();
+    snapshot.process = readProcessFigures();
+    snapshot.machine = machineFacts(snapshot.show.manifest);
     res.set_content(healthJson(snapshot), "application/json");
+  });
+  http.Get("/log.txt", [this](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    res.set_header("Content-Disposition", "inline; filename=\"basalt.log\"");
+    res.set_content(logText(board_.logRecords()), "text/plain; charset=utf-8");
   });
   http.Get("/metrics", [this, now](const httplib::Request&, httplib::Response& res) {
     StatusSnapshot snapshot = board_.snapshot(now());
@@ -519,7 +540,7 @@ void StatusServer::routes() {
       if (requestBody(req, reader)) answer(req, res);
     };
   };
-  for (const char* path : {"/health", "/metrics", "/snapshot.png", "/"}) {
+  for (const char* path : {"/health", "/metrics", "/snapshot.png", "/log.txt", "/"}) {
     http.Post(path, withBody("GET"));
     http.Put(path, withBody("GET"));
     http.Patch(path, withBody("GET"));

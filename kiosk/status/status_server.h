@@ -11,6 +11,7 @@
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -70,6 +71,9 @@ class StatusServer {
   /// The server's thread: binds, retrying with back-off until it can or the server is stopped,
   /// then serves.
   void serve();
+  /// The machine's facts, with the show's folder (that of `manifest`) and the board's folders;
+  /// read again when a second old.
+  MachineFacts machineFacts(const std::string& manifest);
 
   StatusSpec spec_;
   StatusBoard& board_;
@@ -89,6 +93,9 @@ class StatusServer {
   std::condition_variable stopWake_;  // wakes a back-off wait when the server is stopped
   bool stopping_ = false;             // guarded by bindMutex_
   std::string notUpBecause_;          // guarded by bindMutex_
+  std::mutex machineMutex_;           // guards machine_, machineRead_
+  std::optional<MachineFacts> machine_;
+  Nanos machineRead_{0};
   std::atomic<std::uint64_t> requests_{0};
   std::atomic<std::uint64_t> rejectedRate_{0};
   std::atomic<std::uint64_t> rejectedAuth_{0};

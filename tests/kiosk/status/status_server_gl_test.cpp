@@ -1,7 +1,8 @@
 // The status and control server of a real `basalt run`, over real HTTP: what /health, /metrics,
-// /snapshot.png and / serve; controls with no token, a wrong token and the right one; malformed,
-// oversized and too frequent requests; and the status page as a phone's browser shows it
-// (headless Chromium), with its screenshot checked.
+// /snapshot.png, /log.txt and / serve; controls with no token, a wrong token and the right one;
+// malformed, oversized and too frequent requests; a second Basalt on the same port; and the
+// status page as a desktop's and a phone's browser show it (headless Chromium), its fields read
+// from the DOM and its screenshots checked.
 // Example failures: /health without the device that is down; a Prometheus line the scraper
 // rejects; a control that runs without a token; a malformed request that crashes or hangs the
 // server; a page that stays empty because its script failed.
@@ -15,6 +16,9 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <tuple>
+
+#include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
 
@@ -455,9 +459,13 @@ token_file = "token"
 
 // ---- The page in a browser -----------------------------------------------------------------
 
-/// Runs headless Chromium on `url` with `extra` arguments; returns its output.
-test::ProcessResult chromium(const std::string& url, const std::vector<std::string>& extra) {
-  const auto profile = test::scratchDir("status-chromium-profile");
+/// Runs headless Chromium on `url` in a window of `width` x `height` with `extra` arguments;
+/// returns its output.
+test::ProcessResult chromium(const std::string& url, const std::vector<std::string>& extra, int width = 412,
+                             int height = 915) {
+  // A profile of this test's own: ctest may run two of these tests at once.
+  const auto profile = test::scratchDir(std::string("status-chromium-profile-") +
+                                        testing::UnitTest::GetInstance()->current_test_info()->name());
   std::vector<std::string> argv{"/usr/bin/chromium",
                                 "--headless",
                                 "--no-sandbox",
@@ -468,68 +476,207 @@ test::ProcessResult chromium(const std::string& url, const std::vector<std::stri
                                 "--disable-sync",
                                 "--hide-scrollbars",
                                 "--user-data-dir=" + profile.string(),
-                                "--window-size=412,915",
+                                "--window-size=" + std::to_string(width) + "," + std::to_string(height),
                                 "--virtual-time-budget=4000"};
   argv.insert(argv.end(), extra.begin(), extra.end());
   argv.push_back(url);
   return test::run(argv, {}, std::chrono::seconds(90));
 }
 
-TEST_F(StatusServer, PageRendersInABrowser) {
-  if (::access("/usr/bin/chromium", X_OK) != 0) {
-    GTEST_SKIP() << "chromium is not installed (apt-get install chromium; it is in scripts/packages.txt)";
-  }
-  ::usleep(300000);
-  const std::string url = "http://127.0.0.1:" + std::to_string(show_->port()) + "/";
-  // The page's script filled it from /health.
-  const auto dom = chromium(url, {"--dump-dom"});
-  ASSERT_EQ(dom.exitCode, 0) << dom.output;
-  EXPECT_NE(dom.output.find("<h1 id=\"show\">Status test</h1>"), std::string::npos) << dom.output;
-  EXPECT_NE(dom.output.find("<span id=\"state\" class=\"degraded\">degraded</span>"), std::string::npos) << dom.output;
-  EXPECT_NE(dom.output.find("<td>dials</td><td class=\"live\">live</td>"), std::string::npos) << dom.output;
-  EXPECT_NE(dom.output.find("<td>knob</td><td class=\"absent\">absent</td>"), std::string::npos) << dom.output;
-  EXPECT_NE(dom.output.find("open, playing: 'first' (1/2)"), std::string::npos) << dom.output;
-  EXPECT_NE(dom.output.find("<td>cam</td><td class=\"live\">live</td>"), std::string::npos) << dom.output;
-  EXPECT_NE(dom.output.find("<td>live</td><td class=\"playing\">playing</td>"), std::string::npos) << dom.output;
-  // The log tail, newest last.
-  const auto log = dom.output.find("<div id=\"log\">");
-  ASSERT_NE(log, std::string::npos) << dom.output;
-  const auto logEnd = dom.output.find("</div>", log);
-  const std::string tail = dom.output.substr(log, logEnd - log);
-  EXPECT_NE(tail.find("info kiosk: first frame on headless 160x120"), std::string::npos) << tail;
-  EXPECT_NE(tail.find("warning kiosk: device 'knob' (hid): no hid 077d:0410 is plugged in"), std::string::npos) << tail;
+/// The text of the element `<TAG ... id="ID" ...>` in `dom`, up to its closing tag (no nesting).
+std::string element(const std::string& dom, const std::string& tag, const std::string& id) {
+  const auto at = dom.find(" id=\"" + id + "\"");
+  if (at == std::string::npos || dom.rfind("<" + tag + " ", at) != dom.rfind('<', at)) return {};
+  if (at == std::string::npos) return {};
+  const auto start = dom.find('>', at) + 1;
+  return dom.substr(start, dom.find("</" + tag + ">", start) - start);
+}
 
-  // And what a phone's screen shows: the header, the amber "degraded" badge, and the live
-  // thumbnail with the cube's colours in it.
-  const auto shot = test::scratchDir("status-chromium") / "page.png";
-  const auto r = chromium(url, {"--screenshot=" + shot.string()});
-  ASSERT_EQ(r.exitCode, 0) << r.output;
-  auto image = media::readImage(shot);
-  ASSERT_TRUE(image) << image.error().describe() << "\n" << r.output;
-  EXPECT_EQ(image->width, 412u);
-  EXPECT_EQ(image->height, 915u);
-  const auto near = [&](std::uint32_t x, std::uint32_t y, int r0, int g0, int b0) {
-    return std::abs(image->at(x, y, 0) - r0) < 12 && std::abs(image->at(x, y, 1) - g0) < 12 &&
-           std::abs(image->at(x, y, 2) - b0) < 12;
-  };
-  EXPECT_TRUE(near(5, 5, 0x20, 0x24, 0x2c)) << "the header's colour";
-  std::size_t amber = 0;
-  std::size_t cube = 0;
-  for (std::uint32_t y = 0; y < image->height; ++y) {
-    for (std::uint32_t x = 0; x < image->width; ++x) {
-      if (y < 60 && near(x, y, 0xc2, 0x7c, 0x0e)) ++amber;
-      const int red = image->at(x, y, 0);
-      const int green = image->at(x, y, 1);
-      const int blue = image->at(x, y, 2);
-      // The cube's faces are saturated primaries and secondaries; the page has none.
-      if ((red > 150 && green < 60 && blue < 60) || (green > 150 && red < 60 && blue < 60) ||
-          (red > 150 && blue > 150 && green < 60) || (green > 150 && blue > 150 && red < 60)) {
-        ++cube;
+/// The first line of a file, or "".
+std::string firstLineOf(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+/// True when the kernel offers a temperature the page could show: a thermal zone, or a hwmon
+/// input (the page's choice among them is tested in machine_facts_test.cpp).
+bool machineHasASensor() {
+  std::error_code ec;
+  for (const char* folder : {"/sys/class/thermal", "/sys/class/hwmon"}) {
+    for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+      for (const char* file : {"temp", "temp1_input"}) {
+        if (std::filesystem::exists(it->path() / file)) return true;
       }
     }
   }
-  EXPECT_GT(amber, 100u) << "the degraded badge";
-  EXPECT_GT(cube, 200u) << "the thumbnail of the frame on screen";
+  return false;
+}
+
+/// The screenshot's pixels: the header's colour at (5, 5), amber badge pixels in the top 60
+/// rows, and pixels of the cube's saturated colours (the thumbnail; the page has none).
+struct ShotFigures {
+  bool header = false;
+  std::size_t amber = 0;
+  std::size_t cube = 0;
+};
+ShotFigures shotFigures(const Image& image) {
+  const auto near = [&](std::uint32_t x, std::uint32_t y, int r0, int g0, int b0) {
+    return std::abs(image.at(x, y, 0) - r0) < 12 && std::abs(image.at(x, y, 1) - g0) < 12 &&
+           std::abs(image.at(x, y, 2) - b0) < 12;
+  };
+  ShotFigures f;
+  f.header = near(5, 5, 0x20, 0x24, 0x2c);
+  for (std::uint32_t y = 0; y < image.height; ++y) {
+    for (std::uint32_t x = 0; x < image.width; ++x) {
+      if (y < 60 && near(x, y, 0xc2, 0x7c, 0x0e)) ++f.amber;
+      const int red = image.at(x, y, 0);
+      const int green = image.at(x, y, 1);
+      const int blue = image.at(x, y, 2);
+      if ((red > 150 && green < 60 && blue < 60) || (green > 150 && red < 60 && blue < 60) ||
+          (red > 150 && blue > 150 && green < 60) || (green > 150 && blue > 150 && red < 60)) {
+        ++f.cube;
+      }
+    }
+  }
+  return f;
+}
+
+// Makes sure the status page shows what a signage technician looks for, filled from /health by
+// its script in a real browser: version and build, host name and addresses, uptimes, disk,
+// memory, CPU temperature (or "no sensor"), the last errors, the frame-lock figures, the devices
+// with a restart button each, the log's tail and its download; and that it reads at desktop and
+// phone widths (screenshots kept under build/docs-images/ for the README). Expected values come
+// from elsewhere: `basalt --version`, git, /proc/sys/kernel/hostname, the machine's own
+// addresses, /sys. Example failures: a field left at its placeholder because /health lacks it;
+// a restart button missing for a device; a layout that a phone cuts off.
+TEST(StatusPage, ShowsWhatATechnicianLooksFor) {
+  std::string why;
+  if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  if (::access("/usr/bin/chromium", X_OK) != 0) {
+    GTEST_SKIP() << "chromium is not installed (apt-get install chromium; it is in scripts/packages.txt)";
+  }
+  std::string manifest = showManifest(true);
+  manifest.replace(manifest.find("Status test"), 11, "Lobby wall");
+  manifest.replace(manifest.find("160x120"), 7, "480x270");
+  const auto dir = test::writeShow("status-page", manifest);
+  std::ofstream(dir / "token") << kToken << "\n";
+  auto show = test::RunningShow::start({(dir / "show.toml").string(), "--realtime", "--no-resume"}, {}, why);
+  ASSERT_TRUE(show) << why;
+  ::usleep(500000);
+  const std::string url = "http://127.0.0.1:" + std::to_string(show->port()) + "/";
+  const auto dom = chromium(url, {"--dump-dom"});
+  ASSERT_EQ(dom.exitCode, 0) << dom.output;
+  const std::string& d = dom.output;
+  EXPECT_EQ(element(d, "h1", "show"), "Lobby wall") << d;
+  EXPECT_NE(d.find("<span id=\"state\" class=\"degraded\">degraded</span>"), std::string::npos) << d;
+
+  // Version and build: as `basalt --version` and git say.
+  const auto version = test::run({(test::binaryDir() / "basalt").string(), "--version"});
+  ASSERT_TRUE(version.output.starts_with("basalt ")) << version.output;
+  const std::string number = version.output.substr(7, version.output.find('\n') - 7);
+  EXPECT_EQ(element(d, "span", "version"), "Basalt " + number) << d;
+  const std::string build = element(d, "dd", "build");
+  EXPECT_TRUE(build.starts_with(number + ", revision ")) << build;
+  const auto git = test::run({"/usr/bin/git", "-C", test::sourceDir().string(), "rev-parse", "--short=12", "HEAD"});
+  if (git.exitCode == 0) {
+    EXPECT_NE(build.find("revision " + git.output.substr(0, 12)), std::string::npos) << build << " vs " << git.output;
+  }
+  // The machine.
+  EXPECT_EQ(element(d, "dd", "hostname"), firstLineOf("/proc/sys/kernel/hostname")) << d;
+  const std::string addresses = element(d, "dd", "addresses");
+  EXPECT_FALSE(addresses.empty() || addresses == "–") << d;
+  EXPECT_EQ(addresses.find("127.0.0.1"), std::string::npos) << addresses;
+  EXPECT_TRUE(
+      std::regex_match(element(d, "dd", "uptimes"), std::regex(R"(Basalt [0-9]+ s · machine [0-9.]+ (s|min|h|days))")))
+      << element(d, "dd", "uptimes");
+  const std::string folder = std::filesystem::canonical(dir).string();
+  EXPECT_TRUE(std::regex_match(element(d, "dd", "disk"),
+                               std::regex(R"(show: [0-9.]+ [kMGT]?B free of [0-9.]+ [kMGT]?B \()" + folder + R"(\))")))
+      << element(d, "dd", "disk") << " for " << folder;
+  EXPECT_TRUE(
+      std::regex_match(element(d, "dd", "memory"),
+                       std::regex(R"([0-9.]+ [kMGT]?B available of [0-9.]+ [kMGT]?B · Basalt uses [0-9.]+ [kMGT]?B)")))
+      << element(d, "dd", "memory");
+  const std::string temperature = element(d, "dd", "temperature");
+  if (machineHasASensor()) {
+    EXPECT_NE(temperature.find(" °C ("), std::string::npos) << temperature;
+  } else {
+    EXPECT_EQ(temperature, "no sensor");
+  }
+  // The last errors (the knob is not plugged in), the frame lock (none here).
+  const std::string errors = element(d, "table", "errors");
+  EXPECT_NE(errors.find("<td class=\"warning nowrap\">warning</td>"), std::string::npos) << errors;
+  EXPECT_NE(errors.find("kiosk: device 'knob' (hid): no hid 077d:0410 is plugged in"), std::string::npos) << errors;
+  EXPECT_NE(element(d, "dl", "lock").find("not frame-locked"), std::string::npos) << d;
+  // Devices, each with a restart button that the token enables; streams.
+  for (const auto& [name, state] : {std::pair{"dials", "live"}, {"knob", "absent"}, {"cam", "live"}}) {
+    EXPECT_NE(d.find(fmt::format("<span class=\"name\">{}</span><span class=\"{}\">{}</span>", name, state, state)),
+              std::string::npos)
+        << name << "\n"
+        << d;
+    EXPECT_TRUE(std::regex_search(
+        d, std::regex(fmt::format(R"(<button data-device="{}" title="close and open {} again">Restart</button>)", name,
+                                  name))))
+        << name << "\n"
+        << d;
+  }
+  EXPECT_NE(d.find("<td class=\"nowrap\">live</td><td class=\"playing nowrap\">playing</td>"), std::string::npos) << d;
+  EXPECT_NE(d.find("open, playing: 'first' (1/2)"), std::string::npos) << d;
+  EXPECT_NE(d.find("<p class=\"notice\" id=\"controls-off\" hidden=\"\">"), std::string::npos) << "controls are on";
+  // The log's tail, newest last, and its download.
+  const std::string tail = element(d, "div", "log");
+  EXPECT_NE(tail.find("info kiosk: first frame on headless 480x270"), std::string::npos) << tail;
+  EXPECT_NE(tail.find("warning kiosk: device 'knob' (hid): no hid 077d:0410 is plugged in"), std::string::npos) << tail;
+  EXPECT_NE(d.find("<a id=\"log-download\" href=\"/log.txt\" download=\"basalt.log\">"), std::string::npos) << d;
+  const auto log = show->get("/log.txt");
+  EXPECT_EQ(log.status, 200);
+  EXPECT_EQ(log.headers.at("Content-Type"), "text/plain; charset=utf-8");
+  EXPECT_NE(log.body.find(" info kiosk: first frame on headless 480x270"), std::string::npos) << log.body;
+  EXPECT_NE(log.body.find(" warning kiosk: device 'knob' (hid): no hid 077d:0410 is plugged in"), std::string::npos)
+      << log.body;
+
+  // What a desktop's and a phone's screens show: the header, the amber "degraded" badge, and the
+  // live thumbnail with the cube's colours in it. Kept for the README.
+  const auto shots = test::binaryDir() / "docs-images";
+  std::filesystem::create_directories(shots);
+  for (const auto& [name, width, height] :
+       {std::tuple{"status-desktop.png", 1280, 1000}, {"status-phone.png", 412, 915}}) {
+    const auto shot = shots / name;
+    const auto r = chromium(url, {"--screenshot=" + shot.string()}, width, height);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    auto image = media::readImage(shot);
+    ASSERT_TRUE(image) << image.error().describe() << "\n" << r.output;
+    EXPECT_EQ(image->width, static_cast<std::uint32_t>(width));
+    EXPECT_EQ(image->height, static_cast<std::uint32_t>(height));
+    const ShotFigures f = shotFigures(*image);
+    EXPECT_TRUE(f.header) << name << ": the header's colour";
+    EXPECT_GT(f.amber, 100u) << name << ": the degraded badge";
+    EXPECT_GT(f.cube, 2000u) << name << ": the thumbnail of the frame on screen";
+  }
+}
+
+// Makes sure a show without a token says on its page that the controls are off, and its
+// buttons cannot be pressed. Example failure: buttons that answer 403 to a puzzled technician.
+TEST(StatusPage, SaysWhenControlsAreOff) {
+  std::string why;
+  if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  if (::access("/usr/bin/chromium", X_OK) != 0) GTEST_SKIP() << "chromium is not installed";
+  const auto dir = test::writeShow("status-page-no-token", showManifest(false));
+  auto show = test::RunningShow::start({(dir / "show.toml").string(), "--realtime", "--no-resume"}, {}, why);
+  ASSERT_TRUE(show) << why;
+  const auto dom = chromium("http://127.0.0.1:" + std::to_string(show->port()) + "/", {"--dump-dom"});
+  ASSERT_EQ(dom.exitCode, 0) << dom.output;
+  EXPECT_NE(dom.output.find("<p class=\"notice\" id=\"controls-off\">Controls are off: this show has no token."),
+            std::string::npos)
+      << dom.output;
+  EXPECT_NE(dom.output.find("<button data-device=\"dials\" disabled=\"\" title=\"controls are off: this show has no "
+                            "token\">Restart</button>"),
+            std::string::npos)
+      << dom.output;
+  EXPECT_NE(dom.output.find("<button data-control=\"next\" disabled=\"\">Next</button>"), std::string::npos)
+      << dom.output;
 }
 
 // Makes sure a show with `[status] snapshot = false` serves no picture and its page shows none:
