@@ -134,6 +134,7 @@ MachineFacts readMachineFacts(const std::vector<FolderToWatch>& folders, const s
   std::array<char, 256> host{};
   if (::gethostname(host.data(), host.size() - 1) == 0) m.hostname = host.data();
   ifaddrs* list = nullptr;
+  std::vector<NetworkAddress> ipv6;  // after the IPv4 addresses, which people type more easily
   if (::getifaddrs(&list) == 0) {
     for (const ifaddrs* a = list; a; a = a->ifa_next) {
       if (!a->ifa_addr || (a->ifa_flags & IFF_LOOPBACK) || !(a->ifa_flags & IFF_UP)) continue;
@@ -147,12 +148,11 @@ MachineFacts readMachineFacts(const std::vector<FolderToWatch>& folders, const s
       } else {
         continue;
       }
-      m.addresses.push_back({a->ifa_name ? a->ifa_name : "", text.data()});
+      (a->ifa_addr->sa_family == AF_INET ? m.addresses : ipv6).push_back({a->ifa_name ? a->ifa_name : "", text.data()});
     }
     ::freeifaddrs(list);
   }
-  std::stable_partition(m.addresses.begin(), m.addresses.end(),
-                        [](const NetworkAddress& a) { return a.address.find(':') == std::string::npos; });
+  m.addresses.insert(m.addresses.end(), ipv6.begin(), ipv6.end());
   std::ifstream uptime("/proc/uptime");
   uptime >> m.uptimeSeconds;
   std::ifstream meminfo("/proc/meminfo");
@@ -198,7 +198,8 @@ ProcessFigures readProcessFigures() {
   p.openFds = fds > 0 ? fds - 1 : 0;
   rlimit limit{};
   if (::getrlimit(RLIMIT_NOFILE, &limit) == 0) p.maxFds = limit.rlim_cur;
-  p.startSeconds = startSeconds();
+  static const std::optional<double> started = startSeconds();  // read once: it never changes
+  p.startSeconds = started;
   return p;
 }
 
