@@ -3,7 +3,7 @@
 /// \file
 /// \brief Sun rasterfiles (`.ras`, and LAVA's `.im8`, `.im24`, `.im32`): LAVA's texture and
 /// "Save Raster" format, read and written by Basalt's own codec (no maintained library in
-/// Debian 12 that Basalt already uses handles them; see ARCHITECTURE.md "Content formats").
+/// Debian 12 that Basalt already uses handles them; see runtime/formats/README.md).
 ///
 /// Reads depths 1, 8 (grey or colour-mapped), 24 and 32, standard, RGB-ordered and
 /// byte-run-length-encoded files. Writes 8-bit grey (with a grey colour map), 24-bit and 32-bit

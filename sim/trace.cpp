@@ -150,7 +150,7 @@ PixelFormat formatByName(std::string_view name) {
 }  // namespace
 
 std::string formatTraceToml(const TraceInfo& info) {
-  std::string out = "# A Basalt trace: replay it with the replay backend (see ARCHITECTURE.md, \"Traces\").\n";
+  std::string out = "# A Basalt trace: replay it with the replay backend (see sim/README.md, \"Traces\").\n";
   out += "format = 1\n";
   out += fmt::format("recorded = {}\n", quote(info.recorded));
   out += fmt::format("host = {}\n", quote(info.host));

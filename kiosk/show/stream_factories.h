@@ -7,7 +7,7 @@
 /// frame loop's thread). `registerShowFactories()` installs them;
 /// runShow calls it before the first show loads, and so do tests.
 ///
-/// Who keeps a device open (ARCHITECTURE.md "Devices in shows"): a dial box of a show is
+/// Who keeps a device open (kiosk/show/README.md): a dial box of a show is
 /// retried by the director's DeviceSlot (its back-off, its status line); the factory's dial box
 /// only finds and opens the device once per attempt. A camera is kept by a DeviceManager of its
 /// own inside its texture stream (absent -> live -> lost -> reopening, with its back-off); the

@@ -10,7 +10,7 @@
 ///   formats::replaceObject(show, *model);                     // LAVA `load_object`
 ///   formats::saveObject(show, "out.obj");                     // LAVA "Save Object"
 ///
-/// Rule for partly bad files (ARCHITECTURE.md, "Content formats"): a statement that is wrong is
+/// Rule for partly bad files (runtime/formats/README.md): a statement that is wrong is
 /// skipped with a warning that says where and what was skipped, and the rest loads; the whole
 /// file is rejected when it cannot be read or decoded, goes over a cap in Limits, or leaves
 /// nothing to draw although it had elements.

@@ -2,7 +2,7 @@
 
 /// \file
 /// \brief The virtual-lab contract for real-backend tests: the BASALT_VLAB_* variables the lab
-/// sets (ARCHITECTURE.md, "Devices: the virtual lab"), and helpers to drive its gadgets.
+/// sets (tools/vlab/README.md), and helpers to drive its gadgets.
 
 #include <cstdint>
 #include <cstdlib>
