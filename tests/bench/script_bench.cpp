@@ -91,7 +91,7 @@ void parseAndRun(benchmark::State& state) {
 }
 
 std::string exampleScript() {
-  std::ifstream in(std::string(BASALT_SOURCE_DIR) + "/tests/script/scripts/example_motion.mdl");
+  std::ifstream in(std::string(BASALT_SOURCE_DIR) + "/tests/runtime/script/scripts/example_motion.mdl");
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
