@@ -9,11 +9,10 @@
 namespace basalt::kiosk {
 
 using script::Action;
-using script::Diagnostic;
-using script::Severity;
 
-std::vector<Diagnostic> checkScriptStatically(const script::Program& program, const std::filesystem::path& folder) {
-  std::vector<Diagnostic> found;
+std::vector<script::Diagnostic> checkScriptStatically(const script::Program& program,
+                                                      const std::filesystem::path& folder) {
+  std::vector<script::Diagnostic> found;
   const runtime::Show cube = script::startupShow();
   bool partsKnown = true;
   for (const script::Instr& in : program.instrs) {
@@ -28,11 +27,11 @@ std::vector<Diagnostic> checkScriptStatically(const script::Program& program, co
       std::error_code ec;
       const std::filesystem::path path = (folder / text).lexically_normal();
       if (!std::filesystem::exists(path, ec)) {
-        found.push_back({Severity::kError, program.file, in.line,
+        found.push_back({script::Severity::kError, program.file, in.line,
                          fmt::format("{}: there is no file {} (names are relative to the script's folder)", def.name,
                                      path.string())});
       } else if (std::filesystem::is_directory(path, ec)) {
-        found.push_back({Severity::kError, program.file, in.line,
+        found.push_back({script::Severity::kError, program.file, in.line,
                          fmt::format("{}: {} is a folder, not a file", def.name, path.string())});
       }
       continue;
@@ -46,7 +45,7 @@ std::vector<Diagnostic> checkScriptStatically(const script::Program& program, co
     std::string message = fmt::format("{}: the start-up cube has no part '{}'", def.name, text);
     if (auto guess = script::closestMatch(text, candidates)) message += fmt::format("; did you mean '{}'?", *guess);
     message += " (its parts are 'face 1' to 'face 6'; part names are case-sensitive)";
-    found.push_back({Severity::kError, program.file, in.line, std::move(message)});
+    found.push_back({script::Severity::kError, program.file, in.line, std::move(message)});
   }
   return found;
 }
@@ -62,14 +61,14 @@ CheckResult checkMdl(const std::filesystem::path& file) {
   const script::Program& program = interpreter->program();
   std::filesystem::path folder = file.parent_path();
   if (folder.empty()) folder = ".";
-  std::vector<Diagnostic> all = program.diagnostics;
-  const std::vector<Diagnostic> more = checkScriptStatically(program, folder);
+  std::vector<script::Diagnostic> all = program.diagnostics;
+  const std::vector<script::Diagnostic> more = checkScriptStatically(program, folder);
   all.insert(all.end(), more.begin(), more.end());
   script::sortByLine(all);
-  for (const Diagnostic& d : all) {
+  for (const script::Diagnostic& d : all) {
     fmt::print("{}:{}: {}: {}\n", d.file, d.line, script::severityName(d.severity), d.message);
-    if (d.severity == Severity::kError) ++result.errors;
-    if (d.severity == Severity::kWarning) ++result.warnings;
+    if (d.severity == script::Severity::kError) ++result.errors;
+    if (d.severity == script::Severity::kWarning) ++result.warnings;
   }
   result.items = program.commandLines;
   return result;

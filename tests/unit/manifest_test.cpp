@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "app/check_command.h"
+#include "kiosk/manifest/content_check.h"
 #include "kiosk/manifest/manifest.h"
 #include "kiosk/show/show_loader.h"
 #include "kiosk/show/stream_factories.h"
