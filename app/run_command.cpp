@@ -648,7 +648,7 @@ int runShow(const RunOptions& options) {
   std::optional<ScriptPlayer> player;
   if (script) {
     ScriptPlayerOptions playerOptions;
-    setScriptVcrOptions(playerOptions, manifest, clock);
+    setScriptVcrOptions(playerOptions, manifest, clock, director.devices());
     playerOptions.outputDir = options.outputDir;
     if (options.saveImage) playerOptions.saveImage = *options.saveImage;
     player.emplace(std::move(*script), show, **renderer, std::move(playerOptions));

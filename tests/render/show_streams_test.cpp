@@ -7,7 +7,8 @@
 // goes on; the scripts' VCR loads, plays, pauses, steps and rewinds a real clip from
 // ../shared/testdata/video; a camera's on_loss picture (its last frame, a test pattern, a colour,
 // or the fallback image) shows while the synthetic camera is unplugged and the live picture
-// comes back with it; a camera asked to mirror that cannot flip is mirrored by the renderer;
+// comes back with it, lost and reopened by the director's one DeviceManager; a camera asked to
+// mirror that cannot flip is mirrored by the renderer;
 // `basalt record`'s Matroska camera video replays frame for frame, bit for bit, at the recorded
 // microsecond; a camera delivering MJPEG (the synthetic one's JPEG-encoded colour bars) shows
 // the same picture as its raw twin, decoded on another thread than the frame loop's, and a
@@ -93,7 +94,9 @@ class Harness {
 
   void run(std::int64_t frames) {
     FrameLoop loop({30, frames}, clock_, &clock_, *loop_, show_, *output_, *renderer_);
+    for (FrameParticipant* p : before_) loop.addParticipant(*p);
     loop.addParticipant(*director_);
+    for (FrameParticipant* p : after_) loop.addParticipant(*p);
     loop.addParticipant(capture_);
     auto stats = loop.run();
     ASSERT_TRUE(stats) << stats.error().describe();
@@ -113,6 +116,16 @@ class Harness {
   }
   StatusBoard& board() { return board_; }
   runtime::Show& show() { return show_; }
+  ShowDirector& director() { return *director_; }
+  /// The run's one event queue (the director's).
+  BoundedQueue<Event>& events() { return events_; }
+  /// Participants of every frame before and after the director (borrowed).
+  void addBefore(FrameParticipant& p) { before_.push_back(&p); }
+  void addAfter(FrameParticipant& p) { after_.push_back(&p); }
+  [[nodiscard]] std::string item() const {
+    const auto* p = director_->policy();
+    return p && p->current().item ? p->current().item->name : std::string();
+  }
   /// The last frame drawn, read back.
   [[nodiscard]] const Image& lastFrame() const { return capture_.image; }
   /// The thread the frame loop drew the last frame on.
@@ -129,6 +142,8 @@ class Harness {
   BoundedQueue<Event> events_{1024};
   runtime::Show show_;
   std::unique_ptr<ShowDirector> director_;
+  std::vector<FrameParticipant*> before_;
+  std::vector<FrameParticipant*> after_;
   struct Capture final : FrameParticipant {
     Image image;
     std::thread::id thread;
@@ -522,6 +537,42 @@ TEST(ShowStreams, ALostCameraShowsItsOnLossColourAndComesBack) {
     EXPECT_EQ(status.streams[0].state, "playing") << status.streams[0].message;
   }
   EXPECT_EQ(orangePixels(h.lastFrame()), 0u) << "the live picture replaced the colour";
+}
+
+// Makes sure a camera's loss and return are the director's DeviceManager's: the camera is one
+// request there, lost and reopened under the same id (no manager of the stream's own), and the
+// texture's line reads the manager's state.
+// Example failure: a camera stream that opens the camera itself, so that the director's manager
+// never hears of it and the status of the show's devices misses it.
+TEST(ShowStreams, ACamerasLossAndReturnGoThroughTheDirectorsDeviceManager) {
+  Harness h("camera-one-manager");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(installLossShow(h, "#ff8000"));
+  const LoadedTexture* camera = h.texture("camera.png");
+  ASSERT_NE(camera, nullptr);
+  ASSERT_NE(camera->stream, nullptr) << camera->streamState;
+  auto row = [&] {
+    const auto all = h.director().devices().status();
+    EXPECT_EQ(all.size(), 1u) << "one request: the camera";
+    return all.empty() ? devices::DeviceStatus{} : all.front();
+  };
+  h.run(9);  // 0.3 s: live
+  const devices::DeviceStatus live = row();
+  ASSERT_EQ(live.state, devices::DeviceState::kLive) << live.lastError;
+  EXPECT_EQ(live.name, "camera");
+  EXPECT_EQ(live.kind, devices::DeviceKind::kVideoSource);
+  // Unplugged 0.4 s after it opened: the manager says so, and the texture's line says what it says.
+  ASSERT_TRUE(runUntil(h, [&] { return row().state == devices::DeviceState::kLost; }));
+  const devices::DeviceStatus lost = row();
+  EXPECT_EQ(lost.id, live.id);
+  EXPECT_FALSE(lost.lastError.empty());
+  h.run(1);
+  EXPECT_TRUE(says(*camera, "is lost: " + lost.lastError)) << camera->stream->describe();
+  // Reopened by the same manager, under the same id.
+  ASSERT_TRUE(runUntil(h, [&] { return row().state == devices::DeviceState::kLive; }));
+  EXPECT_EQ(row().id, live.id);
+  ASSERT_TRUE(runUntil(h, [&] { return !says(*camera, "showing"); })) << camera->stream->describe();
+  EXPECT_TRUE(camera->live);
 }
 
 TEST(ShowStreams, EveryOnLossKindShowsWhileTheCameraIsGone) {
