@@ -30,6 +30,8 @@ constexpr Nanos kSaveEvery = std::chrono::seconds(2);
 ShowDirector::ShowDirector(DirectorContext context)
     : context_(context), devices_(std::make_unique<devices::DeviceManager>(context_.clock, context_.events)) {
   context_.board.setShowClock(context_.clock);
+  input_.reserve(context_.events.capacity());
+  inputLater_.reserve(context_.events.capacity());
 }
 
 ShowDirector::~ShowDirector() {
@@ -46,6 +48,11 @@ ShowDirector::~ShowDirector() {
 }
 
 void ShowDirector::noteHotplug() { devices_->notifyHotplug({devices::HotplugEvent::Action::kAdded, {}, {}}); }
+
+void ShowDirector::setReplayInput(runtime::Bindings* bindings, std::vector<DeviceId> devices) {
+  replayBindings_ = bindings;
+  replayDevices_ = std::move(devices);
+}
 
 void ShowDirector::install(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume) {
   takeOver(std::move(show), now, resume);
@@ -438,11 +445,18 @@ DeviceSlot* ShowDirector::slotFor(DeviceId id) {
 }
 
 void ShowDirector::applyInput(Nanos until) {
-  context_.events.drainWhile([until](const Event& e) { return e.time <= until; },
-                             [this, until](Event e) { applyEvent(e, until); });
+  // The run's one queue: the show's devices and a replayed trace push into it; this is where
+  // their events leave it, in the order of their times.
+  takeDueInput(context_.events, until, input_, inputLater_);
+  for (const Event& e : input_) applyEvent(e, until);
 }
 
 void ShowDirector::applyEvent(const Event& e, Nanos now) {
+  if (replayBindings_ && std::ranges::find(replayDevices_, e.device) != replayDevices_.end()) {
+    // A replayed trace turns the show through LAVA's table; it is not a visitor.
+    replayBindings_->apply(e, context_.show);
+    return;
+  }
   DeviceSlot* slot = slotFor(e.device);
   if (!slot) return;  // a device of a show that was replaced
   if (e.kind == EventKind::kDeviceState) {
@@ -515,8 +529,11 @@ void ShowDirector::applyOutputInput(Nanos now) {
 
 void ShowDirector::advanceShuttles(Nanos now) {
   // Shuttle rings held off-centre turn the show by the show time since the last frame.
-  if (player_ && lastAdvance_.count() >= 0 && now > lastAdvance_) {
-    for (DeviceSlot& slot : show_->devices) slot.dials.advance(now - lastAdvance_, context_.show);
+  if (lastAdvance_.count() >= 0 && now > lastAdvance_) {
+    if (player_) {
+      for (DeviceSlot& slot : show_->devices) slot.dials.advance(now - lastAdvance_, context_.show);
+    }
+    if (replayBindings_) replayBindings_->advance(now - lastAdvance_, context_.show);
   }
   lastAdvance_ = now;
 }

@@ -3,8 +3,8 @@
 /// \file
 /// \brief The show director: the frame participant that runs a loaded show. Each frame it takes
 /// a reloaded show over when one is ready, answers control requests, hears from its
-/// devices::DeviceManager what became of the show's devices, applies their input (visitor
-/// activity, dial bindings, button actions), lets the kiosk policy decide what
+/// devices::DeviceManager what became of the show's devices, applies the run's input (visitor
+/// activity, dial bindings, button actions, a replayed trace), lets the kiosk policy decide what
 /// plays and switches items, display power and textures accordingly, feeds the playing item its
 /// frame, and saves where the show is.
 
@@ -73,6 +73,11 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   /// \brief The manager that runs the show's devices (its dial boxes and the cameras its
   /// textures show), for what else shows a device of the show (the scripts' VCR camera).
   [[nodiscard]] devices::DeviceManager& devices() { return *devices_; }
+  /// \brief Devices a run adds beside its show's (`basalt run --replay`): they push into the
+  /// same queue, and their events turn the show through `bindings` (borrowed: LAVA's table, the
+  /// Zoom dials) without counting as a visitor. Their ids must not be the show's
+  /// (DeviceWiring numbers them apart).
+  void setReplayInput(runtime::Bindings* bindings, std::vector<DeviceId> devices);
   /// \brief Re-reads the manifest on a loader thread; the current show plays on until the new
   /// one is ready, and stays when the new one has errors.
   void requestReload();
@@ -172,6 +177,10 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   std::vector<std::string> requested_;    // names the show holds in devices_
   std::uint64_t devicesSeen_ = 0;         // devices_->statusVersion() last mirrored
   std::vector<PendingRestart> restarts_;  // frame loop only
+  std::vector<Event> input_;              // the frame's input, in time order (capacity kept)
+  std::vector<Event> inputLater_;         // input taken from the queue before it was due
+  runtime::Bindings* replayBindings_ = nullptr;
+  std::vector<DeviceId> replayDevices_;
   std::unique_ptr<LoadedShow> show_;
   std::unique_ptr<devices::UdevMonitor> udev_;  // a device came: retry the absent at once
   std::unique_ptr<KioskPolicy> policy_;

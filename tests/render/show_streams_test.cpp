@@ -3,8 +3,9 @@
 // plays its movie on its texture; the camera-sculpture example, with its V4L2 camera swapped for
 // the synthetic one (no V4L2 device exists here, and the test says so) and its PowerMate for a
 // replayed recording, shows the live camera; a replayed dial box turns the show through its
-// binding; a dial box that is not plugged in shows in the status with its reason and the show
-// goes on; the scripts' VCR loads, plays, pauses, steps and rewinds a real clip from
+// binding; a replayed trace (`--replay`) and the show's own dial box deliver through the one
+// queue the director drains; a dial box that is not plugged in shows in the status with its
+// reason and the show goes on; the scripts' VCR loads, plays, pauses, steps and rewinds a real clip from
 // ../shared/testdata/video; a camera's on_loss picture (its last frame, a test pattern, a colour,
 // or the fallback image) shows while the synthetic camera is unplugged and the live picture
 // comes back with it, lost and reopened by the director's one DeviceManager; a camera asked to
@@ -33,6 +34,7 @@
 
 #include "kiosk/loop/frame_loop.h"
 #include "kiosk/manifest/manifest.h"
+#include "kiosk/show/device_wiring.h"
 #include "kiosk/show/readers.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/show_director.h"
@@ -282,6 +284,74 @@ gain = 180
   EXPECT_EQ(knob->state, devices::DeviceState::kLive) << knob->message;
   h.run(75);
   EXPECT_FALSE(h.show().position().global == before) << "two turns of the replayed knob did not turn the show";
+}
+
+/// Takes what is due by each frame's time after the director drained the queue: nothing may be.
+struct LeftOver final : FrameParticipant {
+  BoundedQueue<Event>* events = nullptr;
+  std::size_t due = 0;
+  Result<void> beforeDraw(const FrameContext& frame) override {
+    due += events->drainWhile([&](const Event& e) { return e.time <= frame.time; }, [](Event) {});
+    return {};
+  }
+};
+
+// Makes sure a replayed trace (`basalt run --replay`) and the show's own dial box deliver through
+// the one queue the director drains: each frame takes every event due from both, the replay
+// turns the show through LAVA's table without counting as a visitor, and the show's dial box
+// wakes the attract loop as a visitor does.
+// Example failures: the replay's events in a queue of their own that nobody drains once the
+// frame loop stopped doing it; a replayed knob that keeps the attract loop from ever starting
+// (or wakes it); a show's dial box whose events the replay's bindings take.
+TEST(ShowStreams, AReplayedTraceAndTheShowsDialBoxDeliverThroughOneQueue) {
+  Harness h("replay-and-dial");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(recordKnob(h.dir() / "knob.trace"));  // dial 0, a tenth of a turn every 100 ms for 2 s
+  const std::string manifest = R"(
+[show]
+entry = "default"
+[devices.dials]
+kind = "dial_box"
+backend = "synthetic"
+loop = false
+script = [ { at = "1s", dial = 1, turns = 0.25 } ]
+[[kiosk.playlist]]
+name = "one"
+entry = "default"
+duration = "1h"
+[kiosk.attract]
+idle_timeout = "30s"
+items = [ { entry = "default", name = "attract" } ]
+)";
+  std::ofstream(h.dir() / "show.toml") << manifest;
+  ASSERT_TRUE(h.install(h.dir() / "show.toml"));
+  Harness still("replay-and-dial-still");
+  OPEN_OR_SKIP(still);
+  std::ofstream(still.dir() / "show.toml") << manifest;
+  ASSERT_TRUE(still.install(still.dir() / "show.toml"));
+
+  DeviceWiring replay(h.clock(), h.events(), kReplayFirstId);
+  auto ids = replay.addReplay(h.dir() / "knob.trace", false);
+  ASSERT_TRUE(ids) << ids.error().describe();
+  ASSERT_EQ(ids->size(), 1u);
+  EXPECT_GE(ids->front(), kReplayFirstId);
+  runtime::Bindings lava = runtime::Bindings::lavaDefaults();
+  h.director().setReplayInput(&lava, *ids);
+  h.addBefore(replay.participant());  // the replay's manager is stepped before the director drains
+  LeftOver left;
+  left.events = &h.events();
+  h.addAfter(left);
+  replay.start(true);
+
+  h.run(27);  // 0.9 s: nine replayed turns, none of the show's dial box yet
+  still.run(27);
+  EXPECT_EQ(h.item(), "attract") << "a replayed trace is not a visitor";
+  EXPECT_FALSE(h.show().position().global == still.show().position().global) << "the replayed turns turned the show";
+  h.run(9);  // 1.2 s: the show's own dial box turned at 1 s
+  EXPECT_EQ(h.item(), "one") << "the show's dial box is a visitor";
+  h.run(30);
+  EXPECT_EQ(left.due, 0u) << "every frame took every event due from both devices";
+  replay.stop();
 }
 
 TEST(ShowStreams, AMissingDialBoxShowsInTheStatusWithItsReason) {
