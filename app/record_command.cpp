@@ -134,7 +134,8 @@ int recordMain(std::span<const std::string_view> args) {
     fmt::print(stderr, "basalt: error: cannot watch for signals: {}\n", r.error().describe());
     return 1;
   }
-  DeviceWiring wiring(clock, nullptr);
+  BoundedQueue<Event> events(4096);  // the devices' events: the recorder taps the reports instead
+  DeviceWiring wiring(clock, events);
   for (auto& p : allProviders()) wiring.manager().addProvider(std::move(p));
   for (auto& r : requests) {
     if (auto id = wiring.manager().request(r); !id) return usageError(id.error().describe());

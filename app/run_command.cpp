@@ -640,6 +640,21 @@ int runShow(const RunOptions& options) {
     director.setViews(views.get());
   }
 
+  // Devices beside the show's: a replayed trace (--replay) pushes into the run's one queue,
+  // numbered apart from the show's devices, and the director applies its events with theirs,
+  // through LAVA's dial table (and the Zoom dials, below). Its stepper comes before the director,
+  // so that under a ManualClock what it has due by a frame is applied in that frame.
+  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  std::unique_ptr<DeviceWiring> devices;
+  if (options.replay) {
+    devices = std::make_unique<DeviceWiring>(clock, events, kReplayFirstId);
+    auto ids = devices->addReplay(*options.replay, !options.replayOnce, matroskaTraceReaderFactory());
+    if (!ids) return failWith(ids.error(), "cannot replay");
+    director.setReplayInput(&bindings, std::move(*ids));
+    frameLoop.addParticipant(devices->participant());
+    devices->start(manual);
+  }
+
   FrameMetrics metrics(board, &events, (*output)->describe());
   frameLoop.addParticipant(metrics);
   frameLoop.addParticipant(director);
@@ -648,7 +663,7 @@ int runShow(const RunOptions& options) {
   std::optional<ScriptPlayer> player;
   if (script) {
     ScriptPlayerOptions playerOptions;
-    setScriptVcrOptions(playerOptions, manifest, clock);
+    setScriptVcrOptions(playerOptions, manifest, clock, director.devices());
     playerOptions.outputDir = options.outputDir;
     if (options.saveImage) playerOptions.saveImage = *options.saveImage;
     player.emplace(std::move(*script), show, **renderer, std::move(playerOptions));
@@ -694,8 +709,6 @@ int runShow(const RunOptions& options) {
     recorder = std::move(*r);
     frameLoop.addParticipant(*recorder);
   }
-  // Devices: a replayed trace drives the show through LAVA's dial table.
-  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
   if (options.zoomDials && videos) {
     // A full turn moves the Zoom picture across the whole output (LAVA: Shift + drag).
     const render::Size size = (*output)->size();
@@ -704,16 +717,6 @@ int runShow(const RunOptions& options) {
     bindings.setDial(static_cast<std::size_t>(options.zoomDials->second),
                      {runtime::Action::kMoveZoomY, static_cast<double>(size.height)});
     videos->followZoomDials(&bindings);
-  }
-  std::unique_ptr<DeviceWiring> devices;
-  if (options.replay) {
-    devices = std::make_unique<DeviceWiring>(clock, [eventLoop] { eventLoop->wake(); });
-    if (auto r = devices->addReplay(*options.replay, !options.replayOnce, matroskaTraceReaderFactory()); !r) {
-      return failWith(r.error(), "cannot replay");
-    }
-    frameLoop.addParticipant(devices->participant());
-    frameLoop.setEvents(&devices->events(), &bindings);
-    devices->start(manual);
   }
 
   // [lock]: the frame lock is the last participant, so that the leader sends the frame's final

@@ -8,7 +8,7 @@
 #include "kiosk/manifest/content_check.h"
 #include "media/image_io.h"
 #include "runtime/log.h"
-#include "sim/synthetic_dial.h"
+#include "sim/providers.h"
 
 namespace basalt::kiosk {
 
@@ -19,7 +19,7 @@ namespace {
 struct Factories {
   std::mutex mutex;
   std::array<StreamFactory, 3> streams;  // by MediaKind; guarded by mutex
-  std::array<DialBoxFactory, 6> dials;   // by DeviceBackend; guarded by mutex
+  std::array<DeviceFactory, 6> devices;  // by DeviceBackend; guarded by mutex
 };
 
 Factories& factories() {
@@ -27,25 +27,35 @@ Factories& factories() {
   return f;
 }
 
-Result<std::unique_ptr<devices::DialBox>> makeDialBox(const DeviceSpec& spec, const Clock& clock) {
-  DialBoxFactory factory;
+/// A synthetic dial box playing the manifest's script, in a backend of its own.
+DeviceSource syntheticDialBox(const DeviceSpec& spec) {
+  sim::SyntheticProvider::Device device;
+  device.candidate = {sim::SyntheticDial::defaultInfo(), devices::DeviceKind::kDialBox, "", "the manifest's script"};
+  device.script.reserve(spec.script.size());
+  for (const SyntheticInput& in : spec.script) {
+    const EventKind kind = in.button ? EventKind::kButton : (in.shuttle ? EventKind::kShuttle : EventKind::kDialDelta);
+    device.script.push_back({in.at, kind, in.index, in.value});
+  }
+  device.loop = spec.loop;
+  DeviceSource source;
+  source.provider = std::make_unique<sim::SyntheticProvider>(std::vector{std::move(device)});
+  source.request.kind = devices::DeviceKind::kDialBox;
+  source.request.match.backend = "synthetic";
+  source.request.options["loop"] = spec.loop ? "true" : "false";
+  return source;
+}
+
+Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec) {
+  const bool dialBox = spec.kind == DeviceKind::kDialBox;
+  if (dialBox && spec.backend == DeviceBackend::kSynthetic) return syntheticDialBox(spec);
+  DeviceFactory factory;
   {
     std::lock_guard lock(factories().mutex);
-    factory = factories().dials[static_cast<std::size_t>(spec.backend)];
+    factory = factories().devices[static_cast<std::size_t>(spec.backend)];
   }
-  if (factory) return factory(spec, clock);
-  if (spec.backend == DeviceBackend::kSynthetic) {
-    std::vector<sim::ScriptedInput> script;
-    script.reserve(spec.script.size());
-    for (const SyntheticInput& in : spec.script) {
-      const EventKind kind =
-          in.button ? EventKind::kButton : (in.shuttle ? EventKind::kShuttle : EventKind::kDialDelta);
-      script.push_back({in.at, kind, in.index, in.value});
-    }
-    return std::make_unique<sim::SyntheticDial>(std::move(script), clock, spec.loop);
-  }
-  return fail(Errc::kUnsupported,
-              fmt::format("this build has no {} dial box backend", deviceBackendName(spec.backend)));
+  if (factory) return factory(spec);
+  return fail(Errc::kUnsupported, fmt::format("this build has no {} {} backend", deviceBackendName(spec.backend),
+                                              dialBox ? "dial box" : "camera"));
 }
 
 }  // namespace
@@ -55,9 +65,9 @@ void setStreamFactory(MediaKind kind, StreamFactory factory) {
   factories().streams[static_cast<std::size_t>(kind)] = std::move(factory);
 }
 
-void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory) {
+void setDeviceFactory(DeviceBackend backend, DeviceFactory factory) {
   std::lock_guard lock(factories().mutex);
-  factories().dials[static_cast<std::size_t>(backend)] = std::move(factory);
+  factories().devices[static_cast<std::size_t>(backend)] = std::move(factory);
 }
 
 std::string entryKey(const EntrySpec& entry) { return entry.path.empty() ? entry.text : entry.path.string(); }
@@ -98,17 +108,25 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
     }
   }
 
-  // Devices and their bindings: LAVA's dial table for a dial box no binding mentions.
+  // Devices and their bindings: LAVA's dial table for a dial box no binding mentions. Nothing
+  // is opened here: the director asks its DeviceManager for them.
   for (const DeviceSpec& spec : m.devices) {
     DeviceSlot slot;
     slot.spec = spec;
-    if (spec.kind == DeviceKind::kDialBox) {
-      auto box = makeDialBox(spec, clock);
-      if (box) {
-        slot.dialBox = std::move(*box);
-      } else {
-        slot.unavailable = box.error().message();
+    auto source = makeDeviceSource(spec);
+    if (source) {
+      slot.source = std::move(*source);
+      slot.source.request.name = spec.name;
+      if (spec.kind == DeviceKind::kDialBox) {
+        // The director says what happens to a show's dial box (its status line, its log), and
+        // retries it less eagerly than a camera.
+        slot.source.upkeep.backoff = kDialBoxBackoff;
+        slot.source.upkeep.quiet = true;
       }
+    } else {
+      slot.unavailable = source.error().message();
+    }
+    if (spec.kind == DeviceKind::kDialBox) {
       // LAVA's dial table with the device's gain and acceleration, then each binding's
       // override of one dial (the others keep LAVA's action).
       slot.dials = runtime::Bindings::lavaDefaults();
@@ -129,16 +147,6 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
         dial.invert = b.invert;
         slot.dials.setDial(b.index, dial);
       }
-    } else {
-      // A camera is opened and kept by the texture stream of the media that shows it (its own
-      // DeviceManager); its slot only names it in the status.
-      StreamFactory cameras;
-      {
-        std::lock_guard lock(factories().mutex);
-        cameras = factories().streams[static_cast<std::size_t>(MediaKind::kCamera)];
-      }
-      slot.unavailable = cameras ? fmt::format("a camera: its state is on the stream of the media that shows it")
-                                 : fmt::format("this build has no {} camera backend", deviceBackendName(spec.backend));
     }
     slot.message = slot.unavailable;
     show->devices.push_back(std::move(slot));

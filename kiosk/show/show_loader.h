@@ -6,10 +6,12 @@
 /// nothing on the screen, so it runs off the frame loop's thread (at start and on SIGHUP) while
 /// the current show keeps playing; the director installs the result between two frames.
 ///
-/// Seams for the parts other efforts build: setDialBoxFactory() for the hid and replay dial
-/// boxes, setStreamFactory() for movie and camera textures (kiosk/show/show_items.h has the item
-/// seam). Without one, the device or stream is reported absent with the reason, its bindings
-/// stay quiet and its texture shows the fallback: the show goes on.
+/// Seams for the parts other efforts build: setDeviceFactory() for the backends of devices (hid,
+/// serial, replay, v4l2, libcamera; synthetic dial boxes are built in), setStreamFactory() for
+/// movie and camera textures (kiosk/show/show_items.h has the item seam). Without one, the
+/// device or stream is reported absent with the reason, its bindings stay quiet and its texture
+/// shows the fallback: the show goes on. Loading opens no device: the director asks its
+/// devices::DeviceManager for them when the show takes over.
 
 #include <array>
 #include <chrono>
@@ -21,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "devices/dial_box.h"
+#include "devices/device_manager.h"
 #include "kiosk/manifest/manifest.h"
 #include "kiosk/policy/kiosk_policy.h"
 #include "kiosk/policy/schedule.h"
@@ -74,6 +76,10 @@ class TextureStream {
   virtual void setLeaderFrame(std::int64_t frame) { (void)frame; }
   /// \brief What the last update() did with the leader's frame.
   [[nodiscard]] virtual LeaderFrameResult leaderFrameResult() const { return LeaderFrameResult::kNone; }
+  /// \brief Cameras: the manager that runs the show's devices, where the stream finds its
+  /// camera by name (the director requested it there). Called by the director before the first
+  /// update(); borrowed, it outlives the stream. Streams without a device ignore it.
+  virtual void useDevices(devices::DeviceManager& devices) { (void)devices; }
 };
 
 using StreamFactory = std::function<Result<std::unique_ptr<TextureStream>>(const MediaSpec& media, const Manifest& show,
@@ -81,30 +87,37 @@ using StreamFactory = std::function<Result<std::unique_ptr<TextureStream>>(const
 /// \brief Registers the stream maker for movies or cameras (call before the first show loads).
 void setStreamFactory(MediaKind kind, StreamFactory factory);
 
-using DialBoxFactory =
-    std::function<Result<std::unique_ptr<devices::DialBox>>(const DeviceSpec& device, const Clock& clock)>;
-/// \brief Registers the dial box maker for a backend (hid, replay). The synthetic backend is
-/// built in.
-void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory);
+/// \brief How a show's device is found: the backend that lists and opens it (loaded with the
+/// device's trace, port or script), what the DeviceManager is asked for, and how it keeps it.
+struct DeviceSource {
+  std::unique_ptr<devices::DeviceProvider> provider;
+  devices::DeviceRequest request;
+  devices::Upkeep upkeep;
+};
 
-/// \brief An open of a dial box running on the director's device thread (system clock).
-struct PendingOpen;
+using DeviceFactory = std::function<Result<DeviceSource>(const DeviceSpec& device)>;
+/// \brief Registers the maker of a backend's devices (dial boxes and cameras alike; the spec
+/// says which). Synthetic dial boxes are built in.
+void setDeviceFactory(DeviceBackend backend, DeviceFactory factory);
+
+/// \brief How long a show's dial box that cannot be opened waits before the next try: 1 s,
+/// doubling to 30 s (cameras keep the DeviceManager's own).
+inline constexpr devices::Backoff kDialBoxBackoff{std::chrono::seconds(1), std::chrono::seconds(30)};
 
 /// \brief One device of a show, with what its inputs do.
 struct DeviceSlot {
   DeviceSpec spec;
-  std::unique_ptr<devices::DialBox> dialBox;  ///< null when this build cannot make it
-  std::string unavailable;                    ///< why there is no device, when there is none
-  runtime::Bindings dials;                    ///< what its dials do to the show
-  std::array<KioskAction, 32> buttons{};      ///< what its buttons do to the kiosk
-  // Kept by the director:
+  /// What the director requests (the provider moves into its DeviceManager then).
+  DeviceSource source;
+  std::string unavailable;                ///< why it cannot be requested ("" when it can)
+  runtime::Bindings dials;                ///< what its dials do to the show
+  std::array<KioskAction, 32> buttons{};  ///< what its buttons do to the kiosk
+  // What the director's DeviceManager says about it, mirrored by the director:
+  DeviceId id = 0;  ///< the id its events carry; 0 while it is not requested
   devices::DeviceState state = devices::DeviceState::kAbsent;
-  std::string message;
+  std::string message;     ///< why it is not live (the manager's last error)
+  std::string deviceName;  ///< the device in use, or the last one used
   WallTime since{};
-  Nanos nextAttempt{0};
-  Nanos backoff{std::chrono::seconds(1)};
-  /// An open running on the director's device thread: until it is done, that thread owns the box.
-  std::shared_ptr<PendingOpen> opening;
 };
 
 /// \brief One named texture of a show.

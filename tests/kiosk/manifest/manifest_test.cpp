@@ -685,7 +685,11 @@ TEST(ManifestDevices, TheSgiSerialBoxOpensOnItsPortAndTurnsItsDials) {
   auto loaded = loadShow(*r.manifest, clock, false);
   ASSERT_TRUE(loaded) << loaded.error().describe();
   DeviceSlot& slot = (*loaded)->devices[0];
-  ASSERT_TRUE(slot.dialBox) << slot.unavailable;
+  ASSERT_TRUE(slot.source.provider) << slot.unavailable;
+  // The show's dial box is the DeviceManager's to open, as the director asks for it.
+  BoundedQueue<Event> events(64);
+  devices::DeviceManager manager(clock, events);
+  ASSERT_TRUE(manager.request(std::move(slot.source.request), std::move(slot.source.provider), slot.source.upkeep));
   // The box answers the reset (0x20) as the real one does.
   std::thread answer([&] {
     pollfd p{master.get(), POLLIN, 0};
@@ -696,18 +700,18 @@ TEST(ManifestDevices, TheSgiSerialBoxOpensOnItsPortAndTurnsItsDials) {
       (void)!::write(master.get(), &ok, 1);
     }
   });
-  BoundedQueue<Event> events(64);
-  auto opened = slot.dialBox->open(1, events);
+  manager.step(clock.now());
   answer.join();
-  ASSERT_TRUE(opened) << opened.error().describe();
-  EXPECT_EQ(slot.dialBox->info().path, port);
+  const devices::DialBox* box = manager.dialBox("sgi");
+  ASSERT_NE(box, nullptr) << manager.status().at(0).lastError;
+  EXPECT_EQ(box->info().path, port);
   const std::uint8_t turn[] = {0x33, 0x00, 0x32};  // dial 3 to count 50: a quarter turn
   ASSERT_EQ(::write(master.get(), turn, 3), 3);
   Event e;
   bool got = false;
   for (int i = 0; i < 400 && !got; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    slot.dialBox->service(clock.now());
+    manager.step(clock.now());
     while (events.pop(e)) {
       if (e.kind == EventKind::kDialDelta) got = true;
       if (got) break;
@@ -718,7 +722,6 @@ TEST(ManifestDevices, TheSgiSerialBoxOpensOnItsPortAndTurnsItsDials) {
   EXPECT_DOUBLE_EQ(e.value, 0.25);
   // LAVA's table: dial 3 scales.
   EXPECT_EQ(slot.dials.dial(3).action, runtime::Action::kScale);
-  slot.dialBox->close();
 }
 
 TEST(ManifestDevices, AHidRecorderFileReplaysAsADialBox) {
@@ -741,16 +744,19 @@ TEST(ManifestDevices, AHidRecorderFileReplaysAsADialBox) {
   auto loaded = loadShow(*r.manifest, clock, false);
   ASSERT_TRUE(loaded) << loaded.error().describe();
   DeviceSlot& slot = (*loaded)->devices[0];
-  ASSERT_TRUE(slot.dialBox) << slot.unavailable;
+  ASSERT_TRUE(slot.source.provider) << slot.unavailable;
   BoundedQueue<Event> events(64);
-  auto opened = slot.dialBox->open(1, events);
-  ASSERT_TRUE(opened) << opened.error().describe();
-  EXPECT_EQ(slot.dialBox->info().vendor, 0x256c) << "the Huion keydial of the recording";
+  devices::DeviceManager manager(clock, events);
+  ASSERT_TRUE(manager.request(std::move(slot.source.request), std::move(slot.source.provider), slot.source.upkeep));
+  manager.step(clock.now());
+  const devices::DialBox* box = manager.dialBox("keydial");
+  ASSERT_NE(box, nullptr) << manager.status().at(0).lastError;
+  EXPECT_EQ(box->info().vendor, 0x256c) << "the Huion keydial of the recording";
   // The recording's dial turn comes at 64.86 s after the start, on the show's clock.
   std::vector<Event> got;
   for (int i = 0; i < 700; ++i) {
     clock.advance(std::chrono::milliseconds(100));
-    slot.dialBox->service(clock.now());
+    manager.step(clock.now());
     Event e;
     while (events.pop(e)) {
       if (e.kind != EventKind::kDeviceState) got.push_back(e);
@@ -759,7 +765,6 @@ TEST(ManifestDevices, AHidRecorderFileReplaysAsADialBox) {
   ASSERT_FALSE(got.empty()) << "the recording's reports came out as events";
   EXPECT_EQ(got[0].kind, EventKind::kDialDelta);
   EXPECT_EQ(got[0].time, Nanos{64'859'915'000});
-  slot.dialBox->close();
 }
 
 // Makes sure a camera's `format` reaches the device spec and the corrupt fault needs MJPEG.
