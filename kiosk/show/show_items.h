@@ -20,6 +20,7 @@
 
 #include "kiosk/loop/frame_loop.h"
 #include "kiosk/manifest/manifest.h"
+#include "media/frame_picker.h"
 #include "render/output.h"
 #include "render/texture_registry.h"
 #include "runtime/error.h"
@@ -27,13 +28,9 @@
 
 namespace basalt::kiosk {
 
-/// \brief Frame-locked followers: how a movie came by the frame it showed in the last frame.
-enum class LeaderFrameResult : std::uint8_t {
-  kNone,       ///< no frame of the leader's was given (a leader, an unlocked show, the leader shows none)
-  kAgreed,     ///< the leader's frame, which this node's own timeline picked too
-  kCorrected,  ///< the leader's frame, which this node's own timeline would not have picked
-  kLate,       ///< the leader's frame did not come in time: the frame before it stayed
-};
+/// \brief Frame-locked followers: how a movie came by the frame it showed in the last frame
+/// (kNone: no frame of the leader's was given: a leader, an unlocked show, the leader shows none).
+using LeaderFrameResult = media::FrameOutcome;
 
 /// \brief Plays one item into the Show.
 ///
