@@ -82,7 +82,10 @@ class ShowDirector::DeviceThread {
   std::thread thread_;                       // last: starts once the rest is built
 };
 
-ShowDirector::ShowDirector(DirectorContext context) : context_(context) { context_.board.setShowClock(context_.clock); }
+ShowDirector::ShowDirector(DirectorContext context, ShowFactories factories)
+    : context_(context), factories_(std::move(factories)) {
+  context_.board.setShowClock(context_.clock);
+}
 
 ShowDirector::~ShowDirector() {
   if (udev_) udev_->stop();
@@ -248,7 +251,7 @@ void ShowDirector::requestReload() {
   const std::filesystem::path file = show_->manifest.file;
   loader_ = std::thread([this, file] {
     Diagnostics diagnostics;
-    auto loaded = readAndLoadShow(file, context_.clock, diagnostics);
+    auto loaded = readAndLoadShow(file, context_.clock, factories_, diagnostics);
     {
       std::lock_guard lock(reloadMutex_);
       reloadReady_ = true;
@@ -742,8 +745,9 @@ void ShowDirector::runCommand(const FrameContext& frame, ControlRequest& request
 }
 
 Result<std::string> ShowDirector::runLeaderCommand(std::string_view command) {
-  return runScriptCommand(command, {context_.show, &context_.renderer.textures(),
-                                    show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
+  return runScriptCommand(factories_.commands, command,
+                          {context_.show, &context_.renderer.textures(),
+                           show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
 }
 
 const LockCommandLog* ShowDirector::commandLog() const { return locked_ && !follower_ ? &commands_ : nullptr; }

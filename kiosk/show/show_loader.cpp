@@ -1,7 +1,5 @@
 #include "kiosk/show/show_loader.h"
 
-#include <mutex>
-
 #include <fmt/format.h>
 #include <fmt/std.h>
 
@@ -16,24 +14,34 @@ BASALT_LOG_CATEGORY(Loader, "kiosk");
 
 namespace {
 
-struct Factories {
-  std::mutex mutex;
-  std::array<StreamFactory, 3> streams;  // by MediaKind; guarded by mutex
-  std::array<DialBoxFactory, 6> dials;   // by DeviceBackend; guarded by mutex
-};
-
-Factories& factories() {
-  static Factories f;
-  return f;
+/// The factory for a dial box of `backend`; null where there is none to make (synthetic: built in).
+const DialBoxFactory* dialBoxFactory(DeviceBackend backend, const ShowFactories& factories) {
+  switch (backend) {
+    case DeviceBackend::kHid: return &factories.hidDialBoxes;
+    case DeviceBackend::kReplay: return &factories.replayDialBoxes;
+    case DeviceBackend::kSerial: return &factories.serialDialBoxes;
+    case DeviceBackend::kV4l2:
+    case DeviceBackend::kLibcamera:
+    case DeviceBackend::kSynthetic: break;
+  }
+  return nullptr;
 }
 
-Result<std::unique_ptr<devices::DialBox>> makeDialBox(const DeviceSpec& spec, const Clock& clock) {
-  DialBoxFactory factory;
-  {
-    std::lock_guard lock(factories().mutex);
-    factory = factories().dials[static_cast<std::size_t>(spec.backend)];
+/// The factory for the texture stream of `kind` (movies and cameras); null for images.
+const StreamFactory* streamFactory(MediaKind kind, const ShowFactories& factories) {
+  switch (kind) {
+    case MediaKind::kMovie: return &factories.movieStreams;
+    case MediaKind::kCamera: return &factories.cameraStreams;
+    case MediaKind::kImage: break;
   }
-  if (factory) return factory(spec, clock);
+  return nullptr;
+}
+
+Result<std::unique_ptr<devices::DialBox>> makeDialBox(const DeviceSpec& spec, const Clock& clock,
+                                                      const ShowFactories& factories) {
+  if (const DialBoxFactory* factory = dialBoxFactory(spec.backend, factories); factory && *factory) {
+    return (*factory)(spec, clock);
+  }
   if (spec.backend == DeviceBackend::kSynthetic) {
     std::vector<sim::ScriptedInput> script;
     script.reserve(spec.script.size());
@@ -50,16 +58,6 @@ Result<std::unique_ptr<devices::DialBox>> makeDialBox(const DeviceSpec& spec, co
 
 }  // namespace
 
-void setStreamFactory(MediaKind kind, StreamFactory factory) {
-  std::lock_guard lock(factories().mutex);
-  factories().streams[static_cast<std::size_t>(kind)] = std::move(factory);
-}
-
-void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory) {
-  std::lock_guard lock(factories().mutex);
-  factories().dials[static_cast<std::size_t>(backend)] = std::move(factory);
-}
-
 std::string entryKey(const EntrySpec& entry) { return entry.path.empty() ? entry.text : entry.path.string(); }
 
 std::optional<Image> readTextureImage(const std::string& texture, const std::filesystem::path& file) {
@@ -71,7 +69,8 @@ std::optional<Image> readTextureImage(const std::string& texture, const std::fil
   return std::move(*image);
 }
 
-Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock, bool readImages) {
+Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock, const ShowFactories& factories,
+                                             bool readImages) {
   auto show = std::make_unique<LoadedShow>();
   show->manifest = std::move(manifest);
   const Manifest& m = show->manifest;
@@ -89,7 +88,7 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
   for (const EntrySpec* entry : entries) {
     const std::string key = entryKey(*entry);
     if (show->players.contains(key) || show->unplayable.contains(key)) continue;
-    auto player = prepareItem(*entry, m);
+    auto player = prepareItem(*entry, m, factories.items);
     if (player) {
       show->players.emplace(key, std::move(*player));
     } else {
@@ -103,7 +102,7 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
     DeviceSlot slot;
     slot.spec = spec;
     if (spec.kind == DeviceKind::kDialBox) {
-      auto box = makeDialBox(spec, clock);
+      auto box = makeDialBox(spec, clock, factories);
       if (box) {
         slot.dialBox = std::move(*box);
       } else {
@@ -132,13 +131,9 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
     } else {
       // A camera is opened and kept by the texture stream of the media that shows it (its own
       // DeviceManager); its slot only names it in the status.
-      StreamFactory cameras;
-      {
-        std::lock_guard lock(factories().mutex);
-        cameras = factories().streams[static_cast<std::size_t>(MediaKind::kCamera)];
-      }
-      slot.unavailable = cameras ? fmt::format("a camera: its state is on the stream of the media that shows it")
-                                 : fmt::format("this build has no {} camera backend", deviceBackendName(spec.backend));
+      slot.unavailable = factories.cameraStreams
+                             ? fmt::format("a camera: its state is on the stream of the media that shows it")
+                             : fmt::format("this build has no {} camera backend", deviceBackendName(spec.backend));
     }
     slot.message = slot.unavailable;
     show->devices.push_back(std::move(slot));
@@ -154,13 +149,9 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
       if (media->kind == MediaKind::kImage) {
         t.imageFile = media->file;
       } else {
-        StreamFactory factory;
-        {
-          std::lock_guard lock(factories().mutex);
-          factory = factories().streams[static_cast<std::size_t>(media->kind)];
-        }
-        if (factory) {
-          auto stream = factory(*media, m, clock);
+        const StreamFactory* factory = streamFactory(media->kind, factories);
+        if (factory && *factory) {
+          auto stream = (*factory)(*media, m, clock);
           if (stream) {
             t.stream = std::move(*stream);
           } else {
@@ -180,7 +171,7 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
 }
 
 Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path& file, const Clock& clock,
-                                                    Diagnostics& diagnostics) {
+                                                    const ShowFactories& factories, Diagnostics& diagnostics) {
   ReadOptions options;
   options.fileCheckers = &contentCheckers();
   auto manifest = readManifest(file, diagnostics, options);
@@ -188,7 +179,7 @@ Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path&
     return fail(Errc::kParse, fmt::format("{} has {} problem{}", file.string(), diagnostics.errorCount(),
                                           diagnostics.errorCount() == 1 ? "" : "s"));
   }
-  return loadShow(std::move(*manifest), clock, true);
+  return loadShow(std::move(*manifest), clock, factories, true);
 }
 
 }  // namespace basalt::kiosk

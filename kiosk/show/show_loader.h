@@ -6,10 +6,11 @@
 /// nothing on the screen, so it runs off the frame loop's thread (at start and on SIGHUP) while
 /// the current show keeps playing; the director installs the result between two frames.
 ///
-/// Seams for the parts other efforts build: setDialBoxFactory() for the hid and replay dial
-/// boxes, setStreamFactory() for movie and camera textures (kiosk/show/show_items.h has the item
-/// seam). Without one, the device or stream is reported absent with the reason, its bindings
-/// stay quiet and its texture shows the fallback: the show goes on.
+/// What it makes items, dial boxes and texture streams with comes in a ShowFactories value,
+/// built where the program starts (app/show_factories.cpp) and passed down to the loader and the
+/// director. Without a factory, the item is unplayable, or the device or stream is reported
+/// absent with the reason, its bindings stay quiet and its texture shows the fallback: the show
+/// goes on.
 
 #include <array>
 #include <chrono>
@@ -76,16 +77,28 @@ class TextureStream {
   [[nodiscard]] virtual LeaderFrameResult leaderFrameResult() const { return LeaderFrameResult::kNone; }
 };
 
+/// \brief Makes the texture stream of a movie or camera. Called off the frame loop's thread.
 using StreamFactory = std::function<Result<std::unique_ptr<TextureStream>>(const MediaSpec& media, const Manifest& show,
                                                                            const Clock& clock)>;
-/// \brief Registers the stream maker for movies or cameras (call before the first show loads).
-void setStreamFactory(MediaKind kind, StreamFactory factory);
 
+/// \brief Makes the dial box of a device. Called off the frame loop's thread.
 using DialBoxFactory =
     std::function<Result<std::unique_ptr<devices::DialBox>>(const DeviceSpec& device, const Clock& clock)>;
-/// \brief Registers the dial box maker for a backend (hid, replay). The synthetic backend is
-/// built in.
-void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory);
+
+/// \brief What a show's items, texture streams and dial boxes are made with, and what runs the
+/// control server's script commands. A plain value: the program builds it where it starts
+/// (app/show_factories.cpp) and hands it to loadShow() and the ShowDirector; tests build the one
+/// they need. An empty member makes what it would make unplayable or absent, with a message that
+/// says so. Threading: the loader's thread calls the factories; they keep no state of their own.
+struct ShowFactories {
+  ItemFactories items;
+  StreamFactory movieStreams;      ///< textures fed by a movie file
+  StreamFactory cameraStreams;     ///< textures fed by a camera
+  DialBoxFactory hidDialBoxes;     ///< `backend = "hid"` (the synthetic backend is built in)
+  DialBoxFactory replayDialBoxes;  ///< `backend = "replay"`: a trace or a hid-recorder file
+  DialBoxFactory serialDialBoxes;  ///< `backend = "serial"`: the SGI dial box on a serial port
+  CommandRunner commands;          ///< the control server's "run a command"
+};
 
 /// \brief An open of a dial box running on the director's device thread (system clock).
 struct PendingOpen;
@@ -135,16 +148,18 @@ std::string entryKey(const EntrySpec& entry);
 
 /// \brief Prepares a validated manifest. Errors only for what makes the show impossible (a time
 /// zone that vanished); unplayable items, devices and streams are recorded and reported.
-/// Without `readImages` texture images are left for the director to read in the background
-/// (start-up: the first frame does not wait for image decoding).
+/// Items, streams and dial boxes are made with `factories`. Without `readImages` texture images
+/// are left for the director to read in the background (start-up: the first frame does not wait
+/// for image decoding).
 [[nodiscard]] Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock,
-                                                           bool readImages = true);
+                                                           const ShowFactories& factories, bool readImages = true);
 
 /// \brief Reads a texture's image, or says why not (a warning) and returns nothing.
 std::optional<Image> readTextureImage(const std::string& texture, const std::filesystem::path& file);
 
 /// \brief Reads, validates and loads `file`: what a reload does on its own thread.
 [[nodiscard]] Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path& file, const Clock& clock,
+                                                                  const ShowFactories& factories,
                                                                   Diagnostics& diagnostics);
 
 }  // namespace basalt::kiosk

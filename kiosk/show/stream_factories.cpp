@@ -1,6 +1,5 @@
 #include "kiosk/show/stream_factories.h"
 
-#include "kiosk/show/movie_item.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/trace_video_glue.h"
 
@@ -254,6 +253,8 @@ class MovieStream final : public TextureStream {
   std::string failure_;
 };
 
+}  // namespace
+
 Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, const Manifest& /*show*/,
                                                        const Clock& clock) {
   std::error_code ec;
@@ -267,6 +268,8 @@ Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, c
   if (!player) return std::unexpected(player.error());
   return std::make_unique<MovieStream>(media, std::move(*player), clock.isManual());
 }
+
+namespace {
 
 // ---------------------------------------------------------------------------------------------
 // Cameras
@@ -506,6 +509,8 @@ class CameraStream final : public TextureStream {
   std::unique_ptr<render::StreamTexture> texture_;
 };
 
+}  // namespace
+
 Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, const Manifest& show,
                                                         const Clock& clock) {
   const DeviceSpec* spec = nullptr;
@@ -573,8 +578,6 @@ Result<std::unique_ptr<devices::DialBox>> makeDialBoxFromSpec(const DeviceSpec& 
   return makeMatchedDialBox(std::move(*provider), std::move(request), clock);
 }
 
-}  // namespace
-
 devices::DeviceMatch deviceMatchFor(const DeviceSpec& spec) {
   devices::DeviceMatch m;
   m.backend = std::string(deviceBackendName(spec.backend));
@@ -624,18 +627,6 @@ void setScriptVcrOptions(ScriptPlayerOptions& options, const Manifest& show, con
     return;
   }
   options.camera = nullptr;
-}
-
-void registerShowFactories() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    setDialBoxFactory(DeviceBackend::kHid, makeDialBoxFromSpec);
-    setDialBoxFactory(DeviceBackend::kReplay, makeDialBoxFromSpec);
-    setDialBoxFactory(DeviceBackend::kSerial, makeDialBoxFromSpec);
-    setStreamFactory(MediaKind::kMovie, makeMovieStream);
-    setStreamFactory(MediaKind::kCamera, makeCameraStream);
-    setItemFactory(EntryKind::kMovie, makeMovieItem);
-  });
 }
 
 std::optional<std::thread::id> mjpegDecodeThread(const TextureStream& stream) {

@@ -1,11 +1,11 @@
 #pragma once
 
 /// \file
-/// \brief What fills the loader's seams (kiosk/show/show_loader.h): dial boxes of the hid and replay
-/// backends, and texture streams for movies (media::MoviePlayer) and cameras (devices'
-/// VideoSources: v4l2, libcamera, synthetic, replay; MJPEG decoded by media::MjpegDecoder off the
-/// frame loop's thread). `registerShowFactories()` installs them;
-/// runShow calls it before the first show loads, and so do tests.
+/// \brief The loader's factories (ShowFactories in kiosk/show/show_loader.h) for devices and
+/// media: dial boxes of the hid, replay and serial backends, and texture streams for movies
+/// (media::MoviePlayer) and cameras (devices' VideoSources: v4l2, libcamera, synthetic, replay;
+/// MJPEG decoded by media::MjpegDecoder off the frame loop's thread). The program puts them into
+/// its ShowFactories where it starts (app/show_factories.cpp); tests pick the ones they need.
 ///
 /// Who keeps a device open (kiosk/show/README.md): a dial box of a show is
 /// retried by the director's DeviceSlot (its back-off, its status line); the factory's dial box
@@ -27,9 +27,19 @@ namespace basalt::kiosk {
 
 struct ScriptPlayerOptions;
 
-/// \brief Registers the hid and replay dial box factories and the movie and camera stream
-/// factories. Idempotent; call before the first show loads.
-void registerShowFactories();
+/// \brief The stream factory for movies (MediaKind::kMovie): a media::MoviePlayer on the file,
+/// started by the stream's first update(). A missing file is an error here.
+[[nodiscard]] Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, const Manifest& show,
+                                                                     const Clock& clock);
+
+/// \brief The stream factory for cameras (MediaKind::kCamera): the manifest's device the media
+/// names, kept open by a DeviceManager of the stream's own.
+[[nodiscard]] Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, const Manifest& show,
+                                                                      const Clock& clock);
+
+/// \brief The dial box factory for the hid, replay and serial backends: a dial box found by the
+/// device's rule through its backend (makeMatchedDialBox) each time it is opened.
+[[nodiscard]] Result<std::unique_ptr<devices::DialBox>> makeDialBoxFromSpec(const DeviceSpec& spec, const Clock& clock);
 
 /// \brief For tests: the thread a camera stream's MJPEG frames are decoded on (never the frame
 /// loop's); none for other streams, cameras that deliver raw frames, and before the first JPEG.
