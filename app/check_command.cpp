@@ -12,7 +12,6 @@
 #include "app/commands.h"
 #include "app/options.h"
 #include "kiosk/manifest/content_check.h"
-#include "kiosk/show/readers.h"
 
 namespace basalt::kiosk {
 
@@ -60,7 +59,6 @@ Exit status: 0 when no file has errors, 1 when one has (or cannot be read), 2 fo
 }
 
 int checkMain(std::span<const std::string_view> args) {
-  registerContentReaders();
   auto parsed = parseOptions("check", args, {{"--help|-h"}});
   if (!parsed) return usageError(parsed.error().describe());
   std::vector<std::filesystem::path> files;

@@ -17,6 +17,7 @@
 
 #include "app/commands.h"
 #include "app/options.h"
+#include "app/show_factories.h"
 #include "devices/evdev/evdev_input.h"
 #include "kiosk/lock/frame_lock.h"
 #include "kiosk/loop/display_views.h"
@@ -25,7 +26,6 @@
 #include "kiosk/policy/state_store.h"
 #include "kiosk/policy/supervisor.h"
 #include "kiosk/show/device_wiring.h"
-#include "kiosk/show/readers.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/show_director.h"
 #include "kiosk/show/show_loader.h"
@@ -444,7 +444,6 @@ std::string hostName() {
 }  // namespace
 
 int runShow(const RunOptions& options) {
-  registerContentReaders();
   Manifest manifest = Manifest::builtinDefault();
   if (options.manifest) {
     auto read = readShowManifest(*options.manifest);
@@ -584,14 +583,15 @@ int runShow(const RunOptions& options) {
   }
 
   // Texture images are read in the background: the first frame does not wait for them.
-  registerShowFactories();  // hid and replay dial boxes, movie and camera streams
-  auto loaded = loadShow(manifest, clock, false);
+  ShowFactories factories = showFactories();
+  auto loaded = loadShow(manifest, clock, factories, false);
   if (!loaded) return failWith(loaded.error(), "cannot load the show");
 
   runtime::Show show;
   FrameLoop frameLoop({fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output, **renderer);
   ShowDirector director(
-      DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps});
+      DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps},
+      std::move(factories));
   director.install(std::move(*loaded), clock.now(), resume);
   // Keyboards and mice where no window delivers them (KMS): read from evdev on a thread of their
   // own, taken by the director each frame the way a window's keys are.

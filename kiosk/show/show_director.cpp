@@ -27,8 +27,10 @@ constexpr Nanos kSaveEvery = std::chrono::seconds(2);
 
 }  // namespace
 
-ShowDirector::ShowDirector(DirectorContext context)
-    : context_(context), devices_(std::make_unique<devices::DeviceManager>(context_.clock, context_.events)) {
+ShowDirector::ShowDirector(DirectorContext context, ShowFactories factories)
+    : context_(context),
+      factories_(std::move(factories)),
+      devices_(std::make_unique<devices::DeviceManager>(context_.clock, context_.events)) {
   context_.board.setShowClock(context_.clock);
   input_.reserve(context_.events.capacity());
   inputLater_.reserve(context_.events.capacity());
@@ -219,7 +221,7 @@ void ShowDirector::requestReload() {
   const std::filesystem::path file = show_->manifest.file;
   loader_ = std::thread([this, file] {
     Diagnostics diagnostics;
-    auto loaded = readAndLoadShow(file, context_.clock, diagnostics);
+    auto loaded = readAndLoadShow(file, context_.clock, factories_, diagnostics);
     {
       std::lock_guard lock(reloadMutex_);
       reloadReady_ = true;
@@ -731,8 +733,9 @@ void ShowDirector::runCommand(const FrameContext& frame, ControlRequest& request
 }
 
 Result<std::string> ShowDirector::runLeaderCommand(std::string_view command) {
-  return runScriptCommand(command, {context_.show, &context_.renderer.textures(),
-                                    show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
+  return runScriptCommand(factories_.commands, command,
+                          {context_.show, &context_.renderer.textures(),
+                           show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
 }
 
 const LockCommandLog* ShowDirector::commandLog() const { return locked_ && !follower_ ? &commands_ : nullptr; }

@@ -60,7 +60,9 @@ struct DirectorContext {
 /// the manifest on a thread of its own and hands the result over through `reloadMutex_`.
 class ShowDirector final : public FrameParticipant, public LockedDirector {
  public:
-  explicit ShowDirector(DirectorContext context);
+  /// \brief A director that reloads shows with `factories` (what the first show was loaded with)
+  /// and runs control commands with its command runner.
+  ShowDirector(DirectorContext context, ShowFactories factories);
   ~ShowDirector() override;
   ShowDirector(const ShowDirector&) = delete;
   ShowDirector& operator=(const ShowDirector&) = delete;
@@ -168,6 +170,7 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   [[nodiscard]] ItemPlayer::Playback playbackFor(const Programme& p) const;
 
   DirectorContext context_;
+  const ShowFactories factories_;  // read by the loader thread too: never changed after construction
   DisplayViews* views_ = nullptr;
   devices::EvdevInput* keyboardsAndMice_ = nullptr;
   // The one owner of the show's devices: opens, retries and closes them (on its own thread on

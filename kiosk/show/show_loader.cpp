@@ -1,7 +1,5 @@
 #include "kiosk/show/show_loader.h"
 
-#include <mutex>
-
 #include <fmt/format.h>
 #include <fmt/std.h>
 
@@ -15,17 +13,6 @@ namespace basalt::kiosk {
 BASALT_LOG_CATEGORY(Loader, "kiosk");
 
 namespace {
-
-struct Factories {
-  std::mutex mutex;
-  std::array<StreamFactory, 3> streams;  // by MediaKind; guarded by mutex
-  std::array<DeviceFactory, 6> devices;  // by DeviceBackend; guarded by mutex
-};
-
-Factories& factories() {
-  static Factories f;
-  return f;
-}
 
 /// A synthetic dial box playing the manifest's script, in a backend of its own.
 DeviceSource syntheticDialBox(const DeviceSpec& spec) {
@@ -45,30 +32,25 @@ DeviceSource syntheticDialBox(const DeviceSpec& spec) {
   return source;
 }
 
-Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec) {
+Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec, const ShowFactories& factories) {
   const bool dialBox = spec.kind == DeviceKind::kDialBox;
   if (dialBox && spec.backend == DeviceBackend::kSynthetic) return syntheticDialBox(spec);
-  DeviceFactory factory;
-  {
-    std::lock_guard lock(factories().mutex);
-    factory = factories().devices[static_cast<std::size_t>(spec.backend)];
-  }
-  if (factory) return factory(spec);
+  if (factories.devices) return factories.devices(spec);
   return fail(Errc::kUnsupported, fmt::format("this build has no {} {} backend", deviceBackendName(spec.backend),
                                               dialBox ? "dial box" : "camera"));
 }
 
+/// The factory for the texture stream of `kind` (movies and cameras); null for images.
+const StreamFactory* streamFactory(MediaKind kind, const ShowFactories& factories) {
+  switch (kind) {
+    case MediaKind::kMovie: return &factories.movieStreams;
+    case MediaKind::kCamera: return &factories.cameraStreams;
+    case MediaKind::kImage: break;
+  }
+  return nullptr;
+}
+
 }  // namespace
-
-void setStreamFactory(MediaKind kind, StreamFactory factory) {
-  std::lock_guard lock(factories().mutex);
-  factories().streams[static_cast<std::size_t>(kind)] = std::move(factory);
-}
-
-void setDeviceFactory(DeviceBackend backend, DeviceFactory factory) {
-  std::lock_guard lock(factories().mutex);
-  factories().devices[static_cast<std::size_t>(backend)] = std::move(factory);
-}
 
 std::string entryKey(const EntrySpec& entry) { return entry.path.empty() ? entry.text : entry.path.string(); }
 
@@ -81,7 +63,8 @@ std::optional<Image> readTextureImage(const std::string& texture, const std::fil
   return std::move(*image);
 }
 
-Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock, bool readImages) {
+Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock, const ShowFactories& factories,
+                                             bool readImages) {
   auto show = std::make_unique<LoadedShow>();
   show->manifest = std::move(manifest);
   const Manifest& m = show->manifest;
@@ -99,7 +82,7 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
   for (const EntrySpec* entry : entries) {
     const std::string key = entryKey(*entry);
     if (show->players.contains(key) || show->unplayable.contains(key)) continue;
-    auto player = prepareItem(*entry, m);
+    auto player = prepareItem(*entry, m, factories.items);
     if (player) {
       show->players.emplace(key, std::move(*player));
     } else {
@@ -113,7 +96,7 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
   for (const DeviceSpec& spec : m.devices) {
     DeviceSlot slot;
     slot.spec = spec;
-    auto source = makeDeviceSource(spec);
+    auto source = makeDeviceSource(spec, factories);
     if (source) {
       slot.source = std::move(*source);
       slot.source.request.name = spec.name;
@@ -162,13 +145,9 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
       if (media->kind == MediaKind::kImage) {
         t.imageFile = media->file;
       } else {
-        StreamFactory factory;
-        {
-          std::lock_guard lock(factories().mutex);
-          factory = factories().streams[static_cast<std::size_t>(media->kind)];
-        }
-        if (factory) {
-          auto stream = factory(*media, m, clock);
+        const StreamFactory* factory = streamFactory(media->kind, factories);
+        if (factory && *factory) {
+          auto stream = (*factory)(*media, m, clock);
           if (stream) {
             t.stream = std::move(*stream);
           } else {
@@ -188,7 +167,7 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
 }
 
 Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path& file, const Clock& clock,
-                                                    Diagnostics& diagnostics) {
+                                                    const ShowFactories& factories, Diagnostics& diagnostics) {
   ReadOptions options;
   options.fileCheckers = &contentCheckers();
   auto manifest = readManifest(file, diagnostics, options);
@@ -196,7 +175,7 @@ Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path&
     return fail(Errc::kParse, fmt::format("{} has {} problem{}", file.string(), diagnostics.errorCount(),
                                           diagnostics.errorCount() == 1 ? "" : "s"));
   }
-  return loadShow(std::move(*manifest), clock, true);
+  return loadShow(std::move(*manifest), clock, factories, true);
 }
 
 }  // namespace basalt::kiosk

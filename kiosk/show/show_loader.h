@@ -6,12 +6,12 @@
 /// nothing on the screen, so it runs off the frame loop's thread (at start and on SIGHUP) while
 /// the current show keeps playing; the director installs the result between two frames.
 ///
-/// Seams for the parts other efforts build: setDeviceFactory() for the backends of devices (hid,
-/// serial, replay, v4l2, libcamera; synthetic dial boxes are built in), setStreamFactory() for
-/// movie and camera textures (kiosk/show/show_items.h has the item seam). Without one, the
-/// device or stream is reported absent with the reason, its bindings stay quiet and its texture
-/// shows the fallback: the show goes on. Loading opens no device: the director asks its
-/// devices::DeviceManager for them when the show takes over.
+/// What it makes items, devices and texture streams with comes in a ShowFactories value, built
+/// where the program starts (app/show_factories.cpp) and passed down to the loader and the
+/// director. Without a factory, the item is unplayable, or the device or stream is reported
+/// absent with the reason, its bindings stay quiet and its texture shows the fallback: the show
+/// goes on. Loading opens no device: the director asks its devices::DeviceManager for them when
+/// the show takes over.
 
 #include <array>
 #include <chrono>
@@ -82,10 +82,9 @@ class TextureStream {
   virtual void useDevices(devices::DeviceManager& devices) { (void)devices; }
 };
 
+/// \brief Makes the texture stream of a movie or camera. Called off the frame loop's thread.
 using StreamFactory = std::function<Result<std::unique_ptr<TextureStream>>(const MediaSpec& media, const Manifest& show,
                                                                            const Clock& clock)>;
-/// \brief Registers the stream maker for movies or cameras (call before the first show loads).
-void setStreamFactory(MediaKind kind, StreamFactory factory);
 
 /// \brief How a show's device is found: the backend that lists and opens it (loaded with the
 /// device's trace, port or script), what the DeviceManager is asked for, and how it keeps it.
@@ -95,10 +94,22 @@ struct DeviceSource {
   devices::Upkeep upkeep;
 };
 
+/// \brief Makes the source of a device (dial box or camera; the spec says which) for a backend
+/// other than the built-in synthetic dial box. Called off the frame loop's thread.
 using DeviceFactory = std::function<Result<DeviceSource>(const DeviceSpec& device)>;
-/// \brief Registers the maker of a backend's devices (dial boxes and cameras alike; the spec
-/// says which). Synthetic dial boxes are built in.
-void setDeviceFactory(DeviceBackend backend, DeviceFactory factory);
+
+/// \brief What a show's items, texture streams and devices are made with, and what runs the
+/// control server's script commands. A plain value: the program builds it where it starts
+/// (app/show_factories.cpp) and hands it to loadShow() and the ShowDirector; tests build the one
+/// they need. An empty member makes what it would make unplayable or absent, with a message that
+/// says so. Threading: the loader's thread calls the factories; they keep no state of their own.
+struct ShowFactories {
+  ItemFactories items;
+  StreamFactory movieStreams;   ///< textures fed by a movie file
+  StreamFactory cameraStreams;  ///< textures fed by a camera
+  DeviceFactory devices;        ///< hid, serial, replay, v4l2 and libcamera devices (synthetic dial boxes are built in)
+  CommandRunner commands;       ///< the control server's "run a command"
+};
 
 /// \brief How long a show's dial box that cannot be opened waits before the next try: 1 s,
 /// doubling to 30 s (cameras keep the DeviceManager's own).
@@ -148,16 +159,18 @@ std::string entryKey(const EntrySpec& entry);
 
 /// \brief Prepares a validated manifest. Errors only for what makes the show impossible (a time
 /// zone that vanished); unplayable items, devices and streams are recorded and reported.
-/// Without `readImages` texture images are left for the director to read in the background
-/// (start-up: the first frame does not wait for image decoding).
+/// Items, streams and dial boxes are made with `factories`. Without `readImages` texture images
+/// are left for the director to read in the background (start-up: the first frame does not wait
+/// for image decoding).
 [[nodiscard]] Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock,
-                                                           bool readImages = true);
+                                                           const ShowFactories& factories, bool readImages = true);
 
 /// \brief Reads a texture's image, or says why not (a warning) and returns nothing.
 std::optional<Image> readTextureImage(const std::string& texture, const std::filesystem::path& file);
 
 /// \brief Reads, validates and loads `file`: what a reload does on its own thread.
 [[nodiscard]] Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path& file, const Clock& clock,
+                                                                  const ShowFactories& factories,
                                                                   Diagnostics& diagnostics);
 
 }  // namespace basalt::kiosk

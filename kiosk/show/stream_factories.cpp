@@ -1,6 +1,5 @@
 #include "kiosk/show/stream_factories.h"
 
-#include "kiosk/show/movie_item.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/trace_video_glue.h"
 
@@ -16,6 +15,7 @@
 #include "devices/libcamera/libcamera_camera.h"
 #include "devices/serial/sgi_dial_box.h"
 #include "devices/v4l2/v4l2_camera.h"
+#include "media/frame_picker.h"
 #include "media/mjpeg_decoder.h"
 #include "media/movie_player.h"
 #include "render/stream_texture.h"
@@ -60,35 +60,23 @@ class MovieStream final : public TextureStream {
       }
       texture_ = std::move(*texture);
     }
-    // Offline (ManualClock) runs wait for the frame due, so that every frame is exact; a show
-    // on the system clock never waits (the newest frame due is shown, or the last one stays),
-    // except a frame-locked follower, which must draw the leader's frame (bounded).
-    const std::chrono::milliseconds patience = manualClock_ ? std::chrono::milliseconds(10000) : patience_;
     if (origin_ && !aligned_) {
-      align(showTime, patience);
+      align(showTime, media::framePatience(manualClock_, patience_));
       // Nothing before the movie is on the group's timeline: a node that showed the clip's first
       // frame meanwhile would show another frame than the others.
       const media::MovieState now = player_->state();
       if (!aligned_ && now != media::MovieState::kFailed && now != media::MovieState::kEmpty) return false;
     }
-    FrameRef frame;
-    if (origin_ && leaderFrame_ >= 0) {
-      // A follower shows the leader's frame by its number, not by its own decoder's timestamps
-      // (a loop of its can come out a fraction of a millisecond longer than the leader's).
-      media::NumberedFrame pick = player_->frameNumbered(leaderFrame_, showTime, patience);
-      frame = std::move(pick.frame);
-      leaderResult_ = leaderFrameResultOf(pick.outcome);
-    } else {
-      if (patience.count() > 0) player_->waitForFrameDue(showTime, patience);
-      frame = player_->frameAt(showTime);
-      if (origin_ && frame && patience.count() > 0) {
-        // The frame a seek onto the group's timeline brought is due when the seek was asked for;
-        // a node that waited for it takes the frame due now as well, so that it shows what the
-        // others show in this very frame.
-        player_->waitForFrameDue(showTime, patience);
-        if (FrameRef newer = player_->frameAt(showTime)) frame = std::move(newer);
-      }
-    }
+    // Offline (ManualClock) runs wait for the frame due, so that every frame is exact; a show
+    // on the system clock never waits (the newest frame due is shown, or the last one stays),
+    // except a frame-locked node, which must draw the group's frame (bounded by its patience).
+    media::PickedFrame pick = media::pickFrame(*player_, {.showTime = showTime,
+                                                          .leaderFrame = origin_ ? leaderFrame_ : -1,
+                                                          .manualClock = manualClock_,
+                                                          .patience = patience_,
+                                                          .onGroupTimeline = origin_.has_value()});
+    FrameRef frame = std::move(pick.frame);
+    leaderResult_ = pick.outcome;
     const media::MovieState state = player_->state();
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) {
       if (!reportedFailure_) {
@@ -185,6 +173,8 @@ class MovieStream final : public TextureStream {
   std::string failure_;
 };
 
+}  // namespace
+
 Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, const Manifest& /*show*/,
                                                        const Clock& clock) {
   std::error_code ec;
@@ -198,6 +188,8 @@ Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, c
   if (!player) return std::unexpected(player.error());
   return std::make_unique<MovieStream>(media, std::move(*player), clock.isManual());
 }
+
+namespace {
 
 // ---------------------------------------------------------------------------------------------
 // Cameras
@@ -462,6 +454,8 @@ const DeviceSpec* cameraSpec(const Manifest& show, const std::string& device) {
   return nullptr;
 }
 
+}  // namespace
+
 Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, const Manifest& show,
                                                         const Clock& clock) {
   if (!cameraSpec(show, media.device)) {
@@ -469,6 +463,8 @@ Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, 
   }
   return std::make_unique<CameraStream>(media, media.device, clock);
 }
+
+namespace {
 
 /// The DeviceManager's request for a camera of the manifest: its size, format, mirror, and the
 /// synthetic backend's scripted faults.
@@ -528,6 +524,8 @@ Result<devices::DeviceRequest> dialBoxRequest(const DeviceSpec& spec) {
   return request;
 }
 
+}  // namespace
+
 Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec) {
   auto provider = providerFor(spec);
   if (!provider) return std::unexpected(provider.error());
@@ -542,8 +540,6 @@ Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec) {
   }
   return source;
 }
-
-}  // namespace
 
 devices::DeviceMatch deviceMatchFor(const DeviceSpec& spec) {
   devices::DeviceMatch m;
@@ -594,19 +590,6 @@ void setScriptVcrOptions(ScriptPlayerOptions& options, const Manifest& show, con
     return;
   }
   options.camera = nullptr;
-}
-
-void registerShowFactories() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    for (const DeviceBackend backend : {DeviceBackend::kHid, DeviceBackend::kSerial, DeviceBackend::kReplay,
-                                        DeviceBackend::kV4l2, DeviceBackend::kLibcamera, DeviceBackend::kSynthetic}) {
-      setDeviceFactory(backend, makeDeviceSource);
-    }
-    setStreamFactory(MediaKind::kMovie, makeMovieStream);
-    setStreamFactory(MediaKind::kCamera, makeCameraStream);
-    setItemFactory(EntryKind::kMovie, makeMovieItem);
-  });
 }
 
 std::optional<std::thread::id> mjpegDecodeThread(const TextureStream& stream) {

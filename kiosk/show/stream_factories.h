@@ -1,11 +1,12 @@
 #pragma once
 
 /// \file
-/// \brief What fills the loader's seams (kiosk/show/show_loader.h): the backends of a manifest's
-/// devices (hid, serial, replay, v4l2, libcamera, synthetic cameras), and texture streams for
-/// movies (media::MoviePlayer) and cameras (devices' VideoSources; MJPEG decoded by
-/// media::MjpegDecoder off the frame loop's thread). `registerShowFactories()` installs them;
-/// runShow calls it before the first show loads, and so do tests.
+/// rief The loader's factories (ShowFactories in kiosk/show/show_loader.h) for devices and
+/// media: the backends of a manifest's devices (hid, serial, replay, v4l2, libcamera, synthetic
+/// cameras), and texture streams for movies (media::MoviePlayer) and cameras (devices'
+/// VideoSources; MJPEG decoded by media::MjpegDecoder off the frame loop's thread). The program
+/// puts them into its ShowFactories where it starts (app/show_factories.cpp); tests pick the ones
+/// they need.
 ///
 /// Who keeps a device open (kiosk/show/README.md): the director's
 /// devices::DeviceManager, for dial boxes and cameras alike (absent -> live -> lost ->
@@ -26,9 +27,19 @@ namespace basalt::kiosk {
 
 struct ScriptPlayerOptions;
 
-/// \brief Registers the hid and replay dial box factories and the movie and camera stream
-/// factories. Idempotent; call before the first show loads.
-void registerShowFactories();
+/// \brief The stream factory for movies (MediaKind::kMovie): a media::MoviePlayer on the file,
+/// started by the stream's first update(). A missing file is an error here.
+[[nodiscard]] Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, const Manifest& show,
+                                                                     const Clock& clock);
+
+/// \brief The stream factory for cameras (MediaKind::kCamera): the manifest's device the media
+/// names, found by name in the director's devices::DeviceManager (TextureStream::useDevices).
+[[nodiscard]] Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, const Manifest& show,
+                                                                      const Clock& clock);
+
+/// \brief The device factory for every backend a manifest names (dial boxes and cameras): the
+/// backend the device is looked for in, and what the director's DeviceManager is asked for.
+[[nodiscard]] Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec);
 
 /// \brief For tests: the thread a camera stream's MJPEG frames are decoded on (never the frame
 /// loop's); none for other streams, cameras that deliver raw frames, and before the first JPEG.

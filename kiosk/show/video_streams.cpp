@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "media/frame_picker.h"
 #include "runtime/log.h"
 
 namespace basalt::kiosk {
@@ -150,18 +151,16 @@ Result<void> VideoStreams::beforeDraw(const FrameContext& frame) {
   }
   for (const auto& s : streams_) {
     media::MoviePlayer& player = *s->player;
-    FrameRef f;
-    if (const std::int64_t leader = std::exchange(s->leaderFrame, -1); follower_ && leader >= 0) {
-      // The leader's frame by its number: two decoders' timestamps need not add up alike.
-      const std::chrono::milliseconds patience = manualClock_ ? std::chrono::milliseconds(10000) : patience_;
-      media::NumberedFrame pick = player.frameNumbered(leader, frame.time, patience);
-      if (pick.outcome == media::NumberedOutcome::kCorrected) ++movieCounts_.corrected;
-      if (pick.outcome == media::NumberedOutcome::kLate) ++movieCounts_.late;
-      f = std::move(pick.frame);
-    } else {
-      if (manualClock_) player.waitForFrameDue(frame.time, std::chrono::seconds(10));
-      f = player.frameAt(frame.time);
-    }
+    // The leader's frame by its number when a follower is given one (used up: the next frame
+    // brings its own); otherwise the stream's own timeline, which waits only offline.
+    const std::int64_t leader = std::exchange(s->leaderFrame, -1);
+    media::PickedFrame pick = media::pickFrame(player, {.showTime = frame.time,
+                                                        .leaderFrame = follower_ ? leader : -1,
+                                                        .manualClock = manualClock_,
+                                                        .patience = patience_});
+    if (pick.outcome == media::FrameOutcome::kCorrected) ++movieCounts_.corrected;
+    if (pick.outcome == media::FrameOutcome::kLate) ++movieCounts_.late;
+    FrameRef f = std::move(pick.frame);
     const media::MovieState state = player.state();
     if (state != s->lastState) {
       s->lastState = state;

@@ -456,7 +456,7 @@ TEST(ManifestBindings, OverridesChangeOneDialOfLavasTable) {
       "[[bindings]]\ndevice = \"dials\"\nbutton = 0\naction = \"reset_view\"\n");
   ASSERT_TRUE(r.manifest) << r.text;
   ManualClock clock;
-  auto loaded = loadShow(*r.manifest, clock, false);
+  auto loaded = loadShow(*r.manifest, clock, ShowFactories{}, false);
   ASSERT_TRUE(loaded) << loaded.error().describe();
   ASSERT_EQ((*loaded)->devices.size(), 1u);
   const runtime::Bindings& b = (*loaded)->devices[0].dials;
@@ -476,7 +476,7 @@ TEST(ManifestBindings, OverridesChangeOneDialOfLavasTable) {
   // Without bindings or device keys: exactly LAVA's table.
   const auto plain = f.read("[devices.dials]\nkind = \"dial_box\"\nbackend = \"synthetic\"\n");
   ASSERT_TRUE(plain.manifest) << plain.text;
-  auto lava = loadShow(*plain.manifest, clock, false);
+  auto lava = loadShow(*plain.manifest, clock, ShowFactories{}, false);
   ASSERT_TRUE(lava) << lava.error().describe();
   const runtime::Bindings expected = runtime::Bindings::lavaDefaults();
   for (std::size_t i = 0; i < runtime::kMaxBoundDials; ++i)
@@ -680,9 +680,10 @@ TEST(ManifestDevices, TheSgiSerialBoxOpensOnItsPortAndTurnsItsDials) {
       f.read("[devices.sgi]\nkind = \"dial_box\"\nbackend = \"serial\"\nmatch = { path = \"" + port + "\" }\n");
   ASSERT_TRUE(r.manifest) << r.text;
   EXPECT_EQ(r.manifest->devices[0].backend, DeviceBackend::kSerial);
-  registerShowFactories();
   ManualClock clock;
-  auto loaded = loadShow(*r.manifest, clock, false);
+  ShowFactories factories;
+  factories.devices = makeDeviceSource;
+  auto loaded = loadShow(*r.manifest, clock, factories, false);
   ASSERT_TRUE(loaded) << loaded.error().describe();
   DeviceSlot& slot = (*loaded)->devices[0];
   ASSERT_TRUE(slot.source.provider) << slot.unavailable;
@@ -739,9 +740,10 @@ TEST(ManifestDevices, AHidRecorderFileReplaysAsADialBox) {
   const auto r =
       f.read("[devices.keydial]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"keydial.hid\"\nloop = false\n");
   ASSERT_TRUE(r.manifest) << r.text;
-  registerShowFactories();
   ManualClock clock;
-  auto loaded = loadShow(*r.manifest, clock, false);
+  ShowFactories factories;
+  factories.devices = makeDeviceSource;
+  auto loaded = loadShow(*r.manifest, clock, factories, false);
   ASSERT_TRUE(loaded) << loaded.error().describe();
   DeviceSlot& slot = (*loaded)->devices[0];
   ASSERT_TRUE(slot.source.provider) << slot.unavailable;

@@ -62,13 +62,23 @@ class FrameRecorder final : public FrameParticipant {
   std::vector<std::size_t> lit_;
 };
 
+/// The content readers (scripts, scenes, models) and the control commands: what the director's
+/// shows here play. No movie or camera stream: a movie texture shows its fallback. Tests that
+/// play a movie item add its factory.
+ShowFactories contentReaders() {
+  ShowFactories f;
+  f.items.script = makeScriptItem;
+  f.items.scene = makeSceneItem;
+  f.items.model = makeModelItem;
+  f.commands = runControlCommand;
+  return f;
+}
+
 /// A show run headless on a ManualClock, frame by frame.
 class Harness {
  public:
   explicit Harness(const std::string& name, WallTime wallStart = WallTime{std::chrono::hours(24 * 20000)})
-      : dir_(test::scratchDir("director-" + name)), clock_(Nanos{0}, wallStart), board_(wallStart, 30) {
-    registerContentReaders();
-  }
+      : dir_(test::scratchDir("director-" + name)), clock_(Nanos{0}, wallStart), board_(wallStart, 30) {}
 
   bool open(std::string& why) {
     auto output = render::createHeadlessOutput({48, 48});
@@ -91,10 +101,11 @@ class Harness {
     Diagnostics d;
     auto m = readManifest(dir_ / "show.toml", d);
     if (!m) return ::testing::AssertionFailure() << d.format();
-    auto loaded = loadShow(std::move(*m), clock_);
+    auto loaded = loadShow(std::move(*m), clock_, factories_);
     if (!loaded) return ::testing::AssertionFailure() << loaded.error().describe();
     director_ = std::make_unique<ShowDirector>(
-        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30});
+        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30},
+        factories_);
     director_->install(std::move(*loaded), clock_.now(), std::nullopt);
     return ::testing::AssertionSuccess();
   }
@@ -120,6 +131,8 @@ class Harness {
   }
 
   ShowDirector& director() { return *director_; }
+  /// What install() loads the show with, and the director reloads it with.
+  ShowFactories& factories() { return factories_; }
   StatusBoard& board() { return board_; }
   FrameRecorder& recorder() { return recorder_; }
   runtime::Show& show() { return show_; }
@@ -133,6 +146,7 @@ class Harness {
   std::filesystem::path dir_;
   ManualClock clock_;
   StatusBoard board_;
+  ShowFactories factories_ = contentReaders();
   std::unique_ptr<render::Output> output_;
   std::unique_ptr<render::Renderer> renderer_;
   std::unique_ptr<runtime::EventLoop> loop_;
@@ -309,7 +323,7 @@ backend = "synthetic"
   Diagnostics d;
   auto m = readManifest(dir / "show.toml", d);
   ASSERT_TRUE(m) << d.format();
-  auto loaded = loadShow(std::move(*m), clock);
+  auto loaded = loadShow(std::move(*m), clock, ShowFactories{});
   ASSERT_TRUE(loaded) << loaded.error().describe();
   ASSERT_EQ((*loaded)->devices.size(), 1u);
   auto gate = std::make_shared<Gate>();
@@ -320,7 +334,8 @@ backend = "synthetic"
   BoundedQueue<Event> events(64);
   {
     ShowDirector director(
-        DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, nullptr, 30});
+        DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, nullptr, 30},
+        ShowFactories{});
     const Nanos t0 = clock.now();
     director.install(std::move(*loaded), t0, std::nullopt);
     // The show's time stands still at t0; the manager keeps its own time on the system clock.
@@ -409,7 +424,7 @@ backend = "synthetic"
   Diagnostics d;
   auto m = readManifest(dir / "show.toml", d);
   ASSERT_TRUE(m) << d.format();
-  auto loaded = loadShow(std::move(*m), clock);
+  auto loaded = loadShow(std::move(*m), clock, ShowFactories{});
   ASSERT_TRUE(loaded) << loaded.error().describe();
   auto looks = std::make_shared<std::vector<Nanos>>();
   (*loaded)->devices[0].source.provider = std::make_unique<EmptyProvider>(clock, looks);
@@ -417,8 +432,8 @@ backend = "synthetic"
   runtime::Show show;
   StatusBoard board(wallStart, 10);
   BoundedQueue<Event> events(64);
-  ShowDirector director(
-      DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, nullptr, 10});
+  ShowDirector director(DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, nullptr, 10},
+                        ShowFactories{});
   director.install(std::move(*loaded), clock.now(), std::nullopt);
   for (std::int64_t n = 0; n <= 700; ++n) {  // 70 s at 10 frames a second
     const Nanos t = frameTime(n, 10);
@@ -713,13 +728,13 @@ struct Clip {
 };
 
 TEST(ShowDirector, AMovieItemPlaysLetterboxedAndTheListMovesOnAtItsEnd) {
-  setItemFactory(EntryKind::kMovie, makeMovieItem);
   Clip clip;
   auto info = media::probeMovie(clip.file);
   ASSERT_TRUE(info) << info.error().describe();
   ASSERT_GT(info->width, info->height) << "the test expects a landscape clip";
   ASSERT_GT(info->duration, Nanos{0});
   Harness h("movie-item");
+  h.factories().items.movie = makeMovieItem;
   OPEN_OR_SKIP(h);
   std::filesystem::copy_file(clip.file, h.dir() / "clip.webm");
   ASSERT_TRUE(h.install(R"(
@@ -758,11 +773,11 @@ duration = "1h"
 }
 
 TEST(ShowDirector, AMovieAloneInItsListLoopsWithoutAGap) {
-  setItemFactory(EntryKind::kMovie, makeMovieItem);
   Clip clip;
   auto info = media::probeMovie(clip.file);
   ASSERT_TRUE(info) << info.error().describe();
   Harness h("movie-loop");
+  h.factories().items.movie = makeMovieItem;
   OPEN_OR_SKIP(h);
   std::filesystem::copy_file(clip.file, h.dir() / "clip.webm");
   ASSERT_TRUE(h.install("[show]\nentry = \"clip.webm\"\n"));
@@ -775,8 +790,8 @@ TEST(ShowDirector, AMovieAloneInItsListLoopsWithoutAGap) {
 }
 
 TEST(ShowDirector, AMovieItemThatCannotPlayIsReportedWithItsLine) {
-  setItemFactory(EntryKind::kMovie, makeMovieItem);
   Harness h("movie-broken");
+  h.factories().items.movie = makeMovieItem;
   OPEN_OR_SKIP(h);
   std::ofstream(h.dir() / "clip.webm") << "not a movie";
   ASSERT_TRUE(h.install(R"(

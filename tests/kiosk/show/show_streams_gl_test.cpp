@@ -35,6 +35,7 @@
 #include "kiosk/loop/frame_loop.h"
 #include "kiosk/manifest/manifest.h"
 #include "kiosk/show/device_wiring.h"
+#include "kiosk/show/movie_item.h"
 #include "kiosk/show/readers.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/show_director.h"
@@ -58,15 +59,24 @@ namespace {
 
 using namespace std::chrono_literals;
 
+/// What `basalt run` plays shows with (app/show_factories.cpp): every reader, stream and dial box.
+ShowFactories everyFactory() {
+  ShowFactories f;
+  f.items = {makeScriptItem, makeSceneItem, makeModelItem, makeMovieItem};
+  f.movieStreams = makeMovieStream;
+  f.cameraStreams = makeCameraStream;
+  f.devices = makeDeviceSource;
+  f.commands = runControlCommand;
+  return f;
+}
+
 /// A manifest's show run headless on a ManualClock by the director.
 class Harness {
  public:
   explicit Harness(const std::string& name)
       : dir_(test::scratchDir("streams-" + name)),
         clock_(Nanos{0}, WallTime{std::chrono::hours(24 * 20000)}),
-        board_(WallTime{std::chrono::hours(24 * 20000)}, 30) {
-    registerShowFactories();
-  }
+        board_(WallTime{std::chrono::hours(24 * 20000)}, 30) {}
 
   bool open(std::string& why) {
     auto output = render::createHeadlessOutput({64, 64});
@@ -86,10 +96,11 @@ class Harness {
     Diagnostics d;
     auto m = readManifest(manifest, d);
     if (!m) return ::testing::AssertionFailure() << d.format();
-    auto loaded = loadShow(std::move(*m), clock_);
+    auto loaded = loadShow(std::move(*m), clock_, factories_);
     if (!loaded) return ::testing::AssertionFailure() << loaded.error().describe();
     director_ = std::make_unique<ShowDirector>(
-        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30});
+        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30},
+        factories_);
     director_->install(std::move(*loaded), clock_.now(), std::nullopt);
     return ::testing::AssertionSuccess();
   }
@@ -138,6 +149,7 @@ class Harness {
   std::filesystem::path dir_;
   ManualClock clock_;
   StatusBoard board_;
+  const ShowFactories factories_ = everyFactory();
   std::unique_ptr<render::Output> output_;
   std::unique_ptr<render::Renderer> renderer_;
   std::unique_ptr<runtime::EventLoop> loop_;
@@ -528,7 +540,6 @@ std::size_t orangePixels(const Image& image) {
 /// The camera-sculpture example with a synthetic camera unplugged 0.4 s after each open, the
 /// camera's media showing `onLoss` while it is gone.
 ::testing::AssertionResult installLossShow(Harness& h, const std::string& onLoss, bool mirror = false) {
-  registerContentReaders();  // the sculpture is a scene
   const auto example = test::sourceDir() / "configs/shows/camera-sculpture";
   for (const char* file : {"sculpture.sce", "sculpture.obj", "camera.png"}) {
     std::filesystem::copy_file(example / file, h.dir() / file, std::filesystem::copy_options::overwrite_existing);
@@ -698,7 +709,6 @@ TEST(ShowStreams, ACameraThatCannotFlipIsMirroredByTheRenderer) {
 /// The camera-sculpture example with a synthetic camera (160x120 colour bars) delivering
 /// `format`, with `faults` (a TOML array, or empty).
 ::testing::AssertionResult installFormatShow(Harness& h, const std::string& format, const std::string& faults = "") {
-  registerContentReaders();
   const auto example = test::sourceDir() / "configs/shows/camera-sculpture";
   for (const char* file : {"sculpture.sce", "sculpture.obj", "camera.png"}) {
     std::filesystem::copy_file(example / file, h.dir() / file, std::filesystem::copy_options::overwrite_existing);
