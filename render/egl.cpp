@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <mutex>
+#include <utility>
 
 #include "render/gl.h"
 
@@ -174,6 +175,63 @@ Result<void> EglContext::makeCurrent(EGLSurface surface) {
   }
   tCurrent = this;
   return {};
+}
+
+Result<EglSurface> EglSurface::createWindow(std::shared_ptr<EglDisplay> display, EGLConfig config, void* nativeWindow,
+                                            std::string_view what) {
+  // The display was opened with eglGetPlatformDisplayEXT (EGL_EXT_platform_base): its windows
+  // are made with the matching platform call.
+  static const auto createPlatformWindowSurface = reinterpret_cast<PFNEGLCREATEPLATFORMWINDOWSURFACEEXTPROC>(
+      eglGetProcAddress("eglCreatePlatformWindowSurfaceEXT"));
+  if (!createPlatformWindowSurface) {
+    return fail(Errc::kUnavailable,
+                fmt::format("cannot make an EGL surface for {}: EGL has no eglCreatePlatformWindowSurfaceEXT", what));
+  }
+  const EGLSurface surface = createPlatformWindowSurface(display->handle(), config, nativeWindow, nullptr);
+  if (surface == EGL_NO_SURFACE) {
+    return fail(Errc::kUnavailable,
+                fmt::format("cannot make an EGL surface for {} ({})", what, eglErrorName(eglGetError())));
+  }
+  return EglSurface(std::move(display), surface);
+}
+
+EglSurface EglSurface::wrap(std::shared_ptr<EglDisplay> display, EGLSurface surface) {
+  if (surface == EGL_NO_SURFACE) return {};
+  return EglSurface(std::move(display), surface);
+}
+
+EglSurface::EglSurface(EglSurface&& other) noexcept
+    : display_(std::move(other.display_)), surface_(std::exchange(other.surface_, EGL_NO_SURFACE)) {}
+
+EglSurface& EglSurface::operator=(EglSurface&& other) noexcept {
+  if (this != &other) {
+    reset();
+    display_ = std::move(other.display_);
+    surface_ = std::exchange(other.surface_, EGL_NO_SURFACE);
+  }
+  return *this;
+}
+
+EGLSurface EglSurface::release() {
+  display_.reset();
+  return std::exchange(surface_, EGL_NO_SURFACE);
+}
+
+void EglSurface::reset() {
+  if (surface_ == EGL_NO_SURFACE) return;
+  const EGLDisplay display = display_->handle();
+  if (eglGetCurrentDisplay() == display &&
+      (eglGetCurrentSurface(EGL_DRAW) == surface_ || eglGetCurrentSurface(EGL_READ) == surface_)) {
+    // EGL destroys a current surface only once it stops being current: let go of it now, keeping
+    // the context where surfaceless contexts are allowed.
+    const EGLContext context = eglGetCurrentContext();
+    if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)) {
+      eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    }
+  }
+  eglDestroySurface(display, surface_);
+  surface_ = EGL_NO_SURFACE;
+  display_.reset();
 }
 
 }  // namespace basalt::render

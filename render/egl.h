@@ -1,8 +1,9 @@
 #pragma once
 
 /// \file
-/// \brief Owners of EGL handles: a display (terminated when the last owner goes) and a context
-/// that keeps its display alive (Magnum's rule: GL objects never outlive what they need).
+/// \brief Owners of EGL handles: a display (terminated when the last owner goes), and a context
+/// and surfaces that keep their display alive (Magnum's rule: GL objects never outlive what they
+/// need).
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
@@ -78,6 +79,45 @@ class EglContext {
   std::shared_ptr<EglDisplay> display_;
   EGLContext context_;
   std::map<std::string, std::uint32_t, std::less<>> programs_;
+};
+
+/// \brief An EGL surface (a window or pbuffer surface). Move-only; keeps its display alive and
+/// destroys the surface with it. A surface still current on this thread is let go first (the
+/// thread keeps its context where EGL allows a context without a surface), so that the surface
+/// is gone when this returns rather than when it stops being current: the native window under it
+/// (a GBM surface, an X window) may go right after.
+///
+/// Threading: destroyed on the thread that has it current, if any.
+class EglSurface {
+ public:
+  EglSurface() = default;
+  /// \brief A window surface on `nativeWindow` as eglCreatePlatformWindowSurface takes it for
+  /// the display's platform: a gbm_surface* on GBM, a pointer to the X Window on X11. `what`
+  /// names the window in the error. (EGLNativeWindowType is not used: its type depends on the
+  /// headers included before EGL's.)
+  static Result<EglSurface> createWindow(std::shared_ptr<EglDisplay> display, EGLConfig config, void* nativeWindow,
+                                         std::string_view what);
+  /// \brief Adopts `surface`, made on `display` by the caller (EGL_NO_SURFACE gives an empty one).
+  static EglSurface wrap(std::shared_ptr<EglDisplay> display, EGLSurface surface);
+  EglSurface(EglSurface&& other) noexcept;
+  EglSurface& operator=(EglSurface&& other) noexcept;
+  EglSurface(const EglSurface&) = delete;
+  EglSurface& operator=(const EglSurface&) = delete;
+  ~EglSurface() { reset(); }
+
+  [[nodiscard]] EGLSurface handle() const { return surface_; }
+  explicit operator bool() const { return surface_ != EGL_NO_SURFACE; }
+  [[nodiscard]] const std::shared_ptr<EglDisplay>& display() const { return display_; }
+  /// \brief Gives the surface up to the caller, who destroys it (the display is let go too).
+  [[nodiscard]] EGLSurface release();
+  /// \brief Destroys the surface now (nothing when empty).
+  void reset();
+
+ private:
+  EglSurface(std::shared_ptr<EglDisplay> display, EGLSurface surface)
+      : display_(std::move(display)), surface_(surface) {}
+  std::shared_ptr<EglDisplay> display_;
+  EGLSurface surface_ = EGL_NO_SURFACE;
 };
 
 /// \brief True when the space-separated extension list `all` names `name` exactly (EGL and GL).
