@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 
+#include "render/gl.h"
 #include "runtime/error.h"
 
 namespace basalt::render {
@@ -50,11 +51,17 @@ class EglDisplay {
 };
 
 /// \brief An OpenGL ES 3 context. Keeps its display alive; destroyed on the thread that owns it.
+///
+/// Owns the GL programs kept in it (keepProgram()): they are deleted with the context, which is
+/// made current for that (without a surface) if it is not, and the thread's current context
+/// restored afterwards.
 class EglContext {
  public:
   /// \brief Creates an ES 3.x context (3.2 where offered, 3.0 at least). `config` may be
-  /// EGL_NO_CONFIG_KHR for a surfaceless context.
-  static Result<std::unique_ptr<EglContext>> create(std::shared_ptr<EglDisplay> display, EGLConfig config);
+  /// EGL_NO_CONFIG_KHR for a surfaceless context. With `shareWith`, the two contexts share
+  /// their objects (textures, buffers, programs); the caller keeps `shareWith` alive meanwhile.
+  static Result<std::unique_ptr<EglContext>> create(std::shared_ptr<EglDisplay> display, EGLConfig config,
+                                                    const EglContext* shareWith = nullptr);
   ~EglContext();
   EglContext(const EglContext&) = delete;
   EglContext& operator=(const EglContext&) = delete;
@@ -67,18 +74,21 @@ class EglContext {
   /// \brief The context this thread last made current through makeCurrent() (null when none,
   /// or when it has been destroyed).
   [[nodiscard]] static EglContext* current();
-  /// \brief A GL program kept under `key` for the context's life (0 when none): what many
+  /// \brief The GL program kept under `key` for the context's life (0 when none): what many
   /// objects compile alike (a stream texture's conversion programs, made again each time a movie
-  /// item starts) is compiled once. The context frees them with itself.
-  [[nodiscard]] std::uint32_t keptProgram(std::string_view key) const;
-  /// \brief Hands program `id` to the context under `key` (the context must be current).
-  void keepProgram(std::string key, std::uint32_t id);
+  /// item starts) is compiled once. The name is borrowed: valid while the context lives.
+  [[nodiscard]] GLuint keptProgram(std::string_view key) const;
+  /// \brief Hands `program` to the context under `key`, replacing (deleting) one kept there
+  /// before; returns its name. The context must be current: the program is one of its own.
+  GLuint keepProgram(std::string key, gl::Program program);
 
  private:
   EglContext(std::shared_ptr<EglDisplay> display, EGLContext context);
+  /// Deletes the kept programs in this context (made current for it where it is not).
+  void deleteKeptPrograms();
   std::shared_ptr<EglDisplay> display_;
   EGLContext context_;
-  std::map<std::string, std::uint32_t, std::less<>> programs_;
+  std::map<std::string, gl::Program, std::less<>> programs_;  // names of this context's
 };
 
 /// \brief An EGL surface (a window or pbuffer surface). Move-only; keeps its display alive and

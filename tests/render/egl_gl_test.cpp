@@ -1,8 +1,13 @@
 // The owners of EGL handles on headless EGL (Mesa's surfaceless platform, llvmpipe here): an EGL
 // surface is destroyed once, by its last owner, and a move hands it on without destroying it; a
-// surface destroyed while current leaves the thread's context current without it.
+// surface destroyed while current leaves the thread's context current without it; a context
+// deletes the programs kept in it when it goes, whether or not it is current then, and gives
+// the thread back the context it had.
 // Example failures: a moved-from surface destroying the surface its new owner draws into; a
-// surface left alive (deferred by EGL) after its GBM surface or X window was destroyed.
+// surface left alive (deferred by EGL) after its GBM surface or X window was destroyed; kept
+// programs that outlive their context in a share group because it was not current when it went
+// (the leak the output teardown had); another context left current, or none, after a context
+// was destroyed beside it.
 
 #include <gtest/gtest.h>
 
@@ -14,6 +19,15 @@
 
 namespace basalt::render {
 namespace {
+
+constexpr const char* kVertex = R"(#version 300 es
+void main() { gl_Position = vec4(0.0, 0.0, 0.0, 1.0); }
+)";
+constexpr const char* kFragment = R"(#version 300 es
+precision mediump float;
+out vec4 colour;
+void main() { colour = vec4(1.0); }
+)";
 
 class EglOwners : public ::testing::Test {
  protected:
@@ -48,8 +62,8 @@ class EglOwners : public ::testing::Test {
     }
     return ok && width == 8;
   }
-  [[nodiscard]] std::unique_ptr<EglContext> context() const {
-    auto c = EglContext::create(display_, config_);
+  [[nodiscard]] std::unique_ptr<EglContext> context(const EglContext* shareWith = nullptr) const {
+    auto c = EglContext::create(display_, config_, shareWith);
     EXPECT_TRUE(c) << (c ? "" : c.error().describe());
     return c ? std::move(*c) : nullptr;
   }
@@ -125,6 +139,82 @@ TEST_F(EglOwners, AWindowSurfaceOnNoWindowFailsWithAMessage) {
   auto surface = EglSurface::createWindow(display_, config_, nullptr, "the test's window");
   ASSERT_FALSE(surface);
   EXPECT_NE(surface.error().describe().find("the test's window"), std::string::npos) << surface.error().describe();
+}
+
+/// A program kept in `context` (current) under `key`; its name.
+GLuint keepOne(EglContext& context, const std::string& key) {
+  auto program = gl::buildProgram(kVertex, kFragment, key);
+  EXPECT_TRUE(program) << (program ? "" : program.error().describe());
+  if (!program) return 0;
+  return context.keepProgram(key, std::move(*program));
+}
+
+TEST_F(EglOwners, ReplacingAKeptProgramDeletesTheOldOne) {
+  auto ctx = context();
+  ASSERT_NE(ctx, nullptr);
+  ASSERT_TRUE(ctx->makeCurrent());
+  const GLuint first = keepOne(*ctx, "test.program");
+  ASSERT_NE(first, 0u);
+  EXPECT_EQ(ctx->keptProgram("test.program"), first);
+  EXPECT_EQ(ctx->keptProgram("test.other"), 0u);
+  const GLuint second = keepOne(*ctx, "test.program");
+  EXPECT_EQ(ctx->keptProgram("test.program"), second);
+  EXPECT_EQ(glIsProgram(first), GL_FALSE) << "the program replaced leaked";
+  EXPECT_EQ(glIsProgram(second), GL_TRUE);
+  EXPECT_EQ(gl::drainErrors(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+// The kept programs are looked for from a second context sharing the first one's objects: they
+// stay there after the first context goes unless the first deleted them.
+TEST_F(EglOwners, AContextDeletesItsKeptProgramsWhileAnotherIsCurrent) {
+  auto owner = context();
+  ASSERT_NE(owner, nullptr);
+  auto witness = context(owner.get());
+  ASSERT_NE(witness, nullptr);
+  ASSERT_TRUE(owner->makeCurrent());
+  const GLuint a = keepOne(*owner, "test.a");
+  const GLuint b = keepOne(*owner, "test.b");
+  ASSERT_NE(a, 0u);
+  ASSERT_NE(b, 0u);
+  ASSERT_TRUE(witness->makeCurrent());
+  ASSERT_EQ(glIsProgram(a), GL_TRUE) << "the contexts do not share their programs";
+  owner.reset();  // not current: the witness is
+  EXPECT_EQ(eglGetCurrentContext(), witness->handle()) << "the thread's context was not given back";
+  EXPECT_EQ(EglContext::current(), witness.get());
+  EXPECT_EQ(glIsProgram(a), GL_FALSE) << "a kept program outlived its context";
+  EXPECT_EQ(glIsProgram(b), GL_FALSE) << "a kept program outlived its context";
+  EXPECT_EQ(gl::drainErrors(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+TEST_F(EglOwners, AContextDeletesItsKeptProgramsWhenNoneIsCurrent) {
+  auto owner = context();
+  ASSERT_NE(owner, nullptr);
+  auto witness = context(owner.get());
+  ASSERT_NE(witness, nullptr);
+  ASSERT_TRUE(owner->makeCurrent());
+  const GLuint kept = keepOne(*owner, "test.kept");
+  ASSERT_NE(kept, 0u);
+  ASSERT_TRUE(eglMakeCurrent(display_->handle(), EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT));
+  owner.reset();
+  EXPECT_EQ(eglGetCurrentContext(), EGL_NO_CONTEXT) << "the deletion left a context current";
+  ASSERT_TRUE(witness->makeCurrent());
+  EXPECT_EQ(glIsProgram(kept), GL_FALSE) << "a kept program outlived its context";
+  EXPECT_EQ(gl::drainErrors(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+TEST_F(EglOwners, AContextDeletesItsKeptProgramsWhileCurrent) {
+  auto owner = context();
+  ASSERT_NE(owner, nullptr);
+  auto witness = context(owner.get());
+  ASSERT_NE(witness, nullptr);
+  ASSERT_TRUE(owner->makeCurrent());
+  const GLuint kept = keepOne(*owner, "test.kept");
+  ASSERT_NE(kept, 0u);
+  owner.reset();
+  EXPECT_EQ(eglGetCurrentContext(), EGL_NO_CONTEXT);
+  EXPECT_EQ(EglContext::current(), nullptr);
+  ASSERT_TRUE(witness->makeCurrent());
+  EXPECT_EQ(glIsProgram(kept), GL_FALSE) << "a kept program outlived its context";
 }
 
 }  // namespace
