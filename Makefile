@@ -3,6 +3,8 @@
 #
 #   make run        build and play the default show (RUN_ARGS to change it)
 #   make test       build and run every test tier this machine can run, with a summary
+#   make install    install the program, its module, the unit, udev rule and example shows
+#                   (DESTDIR=/some/root to stage them)
 #   make bench      build and run the benchmarks, printing their figures
 #   make lint       clang-format and clang-tidy, as CI checks them
 #   make format     reformat the sources with clang-format
@@ -17,7 +19,7 @@ RUN_ARGS ?= --seconds 10 --record out/default_show.mp4
 CMAKE_ARGS ?=
 FUZZ_SECONDS ?= 60
 
-.PHONY: all setup configure build run test bench lint format sanitize fuzz vlab vlab-shell clean
+.PHONY: all setup configure build run install test bench lint format sanitize fuzz vlab vlab-shell clean
 
 all: build
 
@@ -32,6 +34,9 @@ build: configure
 
 run: build
 	$(BUILD)/basalt run $(RUN_ARGS)
+
+install: build
+	@cmake --install $(BUILD)
 
 test: build
 	@scripts/run-tests.sh $(BUILD)
