@@ -5,6 +5,7 @@
 #   make test       build and run every test tier this machine can run, with a summary
 #   make install    install the program, its module, the unit, udev rule and example shows
 #                   (DESTDIR=/some/root to stage them)
+#   make package    the Debian package of the same files: build/basalt_VERSION_ARCH.deb
 #   make bench      build and run the benchmarks, printing their figures
 #   make lint       clang-format and clang-tidy, as CI checks them
 #   make format     reformat the sources with clang-format
@@ -19,7 +20,7 @@ RUN_ARGS ?= --seconds 10 --record out/default_show.mp4
 CMAKE_ARGS ?=
 FUZZ_SECONDS ?= 60
 
-.PHONY: all setup configure build run install test bench lint format sanitize fuzz vlab vlab-shell clean
+.PHONY: all setup configure build run install package test bench lint format sanitize fuzz vlab vlab-shell clean
 
 all: build
 
@@ -37,6 +38,9 @@ run: build
 
 install: build
 	@cmake --install $(BUILD)
+
+package: build
+	@cd $(BUILD) && cpack -G DEB
 
 test: build
 	@scripts/run-tests.sh $(BUILD)

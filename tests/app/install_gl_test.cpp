@@ -13,6 +13,7 @@
 #include <stdlib.h>  // mkdtemp
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <regex>
@@ -213,6 +214,64 @@ TEST_F(StagedInstall, InstalledProgramNeverLoadsTheBuildFoldersModule) {
   const auto played = runStaged(show / "show.toml", root_ / "snapshot.pam");
   EXPECT_NE(played.output.find("libbasalt_oiio.so is not installed"), std::string::npos) << played.output;
   EXPECT_EQ(played.output.find("loaded the OpenImageIO module"), std::string::npos) << played.output;
+}
+
+// Makes sure the Debian package CPack builds holds the installed files and depends on what runs
+// Basalt only: the libraries the program and its module link (dpkg-shlibdeps), Mesa's drivers and
+// the GStreamer plugins it opens at run time, and nothing of the build or the tests.
+// Example failures: a -dev package or a test tool in Depends (a kiosk pulls in compilers); the
+// module's OpenImageIO missing from Depends (dpkg-shlibdeps not run on it); the package without
+// its module or unit.
+TEST(DebianPackage, HoldsTheInstalledFilesAndDependsOnRuntimePackagesOnly) {
+  if (::access("/usr/bin/dpkg-shlibdeps", X_OK) != 0) GTEST_SKIP() << "dpkg-shlibdeps is not installed (dpkg-dev)";
+  const fs::path out = test::scratchDir("debian-package");
+  const auto packed = test::run({BASALT_CPACK_COMMAND, "-G", "DEB", "--config",
+                                 (test::binaryDir() / "CPackConfig.cmake").string(), "-B", out.string()},
+                                {}, std::chrono::seconds(300));
+  ASSERT_EQ(packed.exitCode, 0) << packed.output;
+  fs::path deb;
+  for (const auto& entry : fs::directory_iterator(out)) {
+    if (entry.path().extension() == ".deb") deb = entry.path();
+  }
+  ASSERT_FALSE(deb.empty()) << packed.output;
+
+  const auto depends = test::run({"/usr/bin/dpkg-deb", "--field", deb.string(), "Depends"});
+  ASSERT_EQ(depends.exitCode, 0) << depends.output;
+  std::vector<std::string> names;
+  std::istringstream list(depends.output);
+  for (std::string item; std::getline(list, item, ',');) {
+    const auto start = item.find_first_not_of(" \n");
+    const auto end = item.find_first_of(" (\n", start);
+    if (start != std::string::npos) names.push_back(item.substr(start, end - start));
+  }
+  const auto has = [&](const std::string& prefix) {
+    return std::any_of(names.begin(), names.end(), [&](const std::string& n) { return n.starts_with(prefix); });
+  };
+  for (const char* wanted :
+       {"libopenimageio", "libgstreamer1.0-0", "libegl1", "libgles2", "libgbm1", "libzmq5", "libcamera0",
+        "libhidapi-hidraw0", "libusb-1.0-0", "libsystemd0", "libegl-mesa0", "libgl1-mesa-dri",
+        "gstreamer1.0-plugins-good", "gstreamer1.0-plugins-ugly", "gstreamer1.0-libav", "gstreamer1.0-alsa"}) {
+    EXPECT_TRUE(has(wanted)) << wanted << " missing from Depends: " << depends.output;
+  }
+  for (const std::string& name : names) {
+    EXPECT_FALSE(name.ends_with("-dev")) << name << " in Depends: " << depends.output;
+    for (const char* testOnly : {"clang", "qemu", "chromium", "xvfb", "libgtest", "gstreamer1.0-tools", "cmake"}) {
+      EXPECT_FALSE(name.starts_with(testOnly)) << name << " in Depends: " << depends.output;
+    }
+  }
+
+  const auto contents = test::run({"/usr/bin/dpkg-deb", "--contents", deb.string()});
+  ASSERT_EQ(contents.exitCode, 0) << contents.output;
+  for (const std::string& file :
+       {std::string("./usr/bin/basalt"), "./usr/" + std::string(BASALT_INSTALL_LIBDIR) + "/basalt/libbasalt_oiio.so",
+        std::string("./usr/lib/systemd/system/basalt.service"), std::string("./usr/lib/sysusers.d/basalt.conf"),
+        std::string("./usr/lib/tmpfiles.d/basalt.conf"), std::string("./usr/lib/udev/rules.d/70-basalt.rules"),
+        std::string("./usr/share/man/man1/basalt.1"), std::string("./usr/share/basalt/shows/default/show.toml")}) {
+    EXPECT_NE(contents.output.find(" " + file + "\n"), std::string::npos) << file << " is not in the package";
+  }
+  const auto scripts = test::run({"/usr/bin/dpkg-deb", "--info", deb.string()});
+  EXPECT_NE(scripts.output.find(" postinst "), std::string::npos) << scripts.output;
+  fs::remove_all(out);
 }
 
 }  // namespace
