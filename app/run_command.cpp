@@ -9,6 +9,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <system_error>
 
@@ -148,8 +149,9 @@ Options:
                      hours (2026-12-24T09:59:00Z)
   --status ADDR:PORT serve status and controls there (default: the manifest's [status];
                      port 0 picks a free one)
-  --state-dir DIR    where the show's resume point is kept (default: $STATE_DIRECTORY,
-                     else ~/.local/state/basalt)
+  --state-dir DIR    where the show's resume point and saved calibrations are kept
+                     (default: $STATE_DIRECTORY, else ~/.local/state/basalt; calibrations
+                     are saved to the show's cave files without either)
   --no-resume        start from the beginning, not where the show was before it stopped
   -h, --help         this text
 
@@ -633,7 +635,16 @@ int runShow(const RunOptions& options) {
   // [[views]]: facets of an immersive display, stereo eyes, tiles (one plain view without).
   std::unique_ptr<DisplayViews> views;
   if (!manifest.views.empty()) {
-    auto made = DisplayViews::create(manifest.views, **renderer, (*output)->size());
+    // Calibrations are saved in the state folder when there is one to write (a service's
+    // StateDirectory=, or --state-dir): the show's folder may be read-only. Otherwise, by hand,
+    // they go back to the show's cave files.
+    std::filesystem::path calibrations;
+    if (options.stateDir) {
+      calibrations = *options.stateDir / "calibration";
+    } else if (const char* dir = std::getenv("STATE_DIRECTORY"); dir && *dir) {
+      calibrations = defaultStateFolder() / "calibration";
+    }
+    auto made = DisplayViews::create(manifest.views, **renderer, (*output)->size(), calibrations);
     if (!made) return failWith(made.error(), "cannot set up the show's views");
     views = std::move(*made);
     frameLoop.setViewDrawer(views.get());

@@ -408,7 +408,7 @@ test::ProcessResult chromium(const std::string& url, const std::vector<std::stri
 
 TEST_F(StatusServer, PageRendersInABrowser) {
   if (::access("/usr/bin/chromium", X_OK) != 0) {
-    GTEST_SKIP() << "chromium is not installed (apt-get install chromium; it is in scripts/packages.txt)";
+    GTEST_SKIP() << "chromium is not installed (apt-get install chromium; it is in scripts/packages-test.txt)";
   }
   ::usleep(300000);
   const std::string url = "http://127.0.0.1:" + std::to_string(show_->port()) + "/";

@@ -3,7 +3,7 @@
 // is really there and works, so that a real-backend test that fails in the lab fails because of
 // Basalt, not because of the lab. Outside the lab each test skips, saying so.
 //
-// External tools they use are Debian's (scripts/packages.txt): v4l2-ctl (v4l-utils) for V4L2,
+// External tools they use are Debian's (scripts/packages-test.txt): v4l2-ctl (v4l-utils) for V4L2,
 // kmscube for KMS, cam (libcamera-tools) for libcamera, so that the lab is checked by programs
 // other than Basalt's own backends.
 
