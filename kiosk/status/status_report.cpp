@@ -72,6 +72,8 @@ std::string jsonString(std::string_view text) {
 }
 
 std::string_view overallState(const StatusSnapshot& s) {
+  // The show's own errors (at start, or at a failed reload) come first.
+  if (!s.problems.empty()) return "degraded";
   for (const DeviceStatus& d : s.devices) {
     // "idle": a camera no texture shows (a script may open it); nothing is wrong with it.
     if (d.state != "live" && d.state != "idle") return "degraded";
@@ -159,6 +161,11 @@ std::string healthJson(const StatusSnapshot& s) {
   out += s.streams.empty() ? "],\n" : "\n  ],\n";
   out += fmt::format("  \"reloads\": {{\"total\": {}, \"failed\": {}, \"last\": {}}},\n", s.reloads, s.reloadFailures,
                      jsonString(s.lastReload));
+  out += "  \"problems\": [";
+  for (std::size_t i = 0; i < s.problems.size(); ++i) {
+    out += fmt::format("{}\n    {}", i ? "," : "", jsonString(s.problems[i]));
+  }
+  out += s.problems.empty() ? "],\n" : "\n  ],\n";
   out += fmt::format("  \"errors_logged\": {},\n", s.errorsLogged);
   out += "  \"last_errors\": [";
   for (std::size_t i = 0; i < s.lastErrors.size(); ++i) {
