@@ -1,5 +1,9 @@
 #include "app/run_command.h"
 
+#include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <net/if.h>
+#include <netinet/in.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +16,7 @@
 #include <cstdlib>
 #include <memory>
 #include <system_error>
+#include <thread>
 
 #include <fmt/format.h>
 #include <fmt/std.h>
@@ -24,6 +29,7 @@
 #include "kiosk/loop/display_views.h"
 #include "kiosk/loop/frame_loop.h"
 #include "kiosk/manifest/manifest.h"
+#include "kiosk/policy/last_good.h"
 #include "kiosk/policy/state_store.h"
 #include "kiosk/policy/supervisor.h"
 #include "kiosk/show/device_wiring.h"
@@ -153,9 +159,19 @@ Options:
                      (default: $STATE_DIRECTORY, else ~/.local/state/basalt; calibrations
                      are saved to the show's cave files without either)
   --no-resume        start from the beginning, not where the show was before it stopped
+  --strict           a show whose manifest or entry has errors does not start: exit 1 (for
+                     CI); without it such a show never goes dark (below)
   -h, --help         this text
 
-Exit status: 0 when the show ran, 1 when it could not start or failed, 2 for usage errors.
+Never dark: every show that starts cleanly is kept as its last good copy in the state folder
+(STATE_DIR/last-good/). When the manifest or its entry has errors, Basalt logs them (file:line)
+and plays the last good copy instead; with none it shows the problem card (an amber screen)
+while the status page says what is wrong, where, and the node's address. Either way the status
+server runs and /health says "degraded" with the errors; fix the show and reload (SIGHUP or
+POST /control/reload). A reload that fails keeps the show playing and is "degraded" too.
+
+Exit status: 0 when the show ran, 1 when it could not start or failed (with --strict also when
+the show has errors), 2 for usage errors.
 )";
 }
 
@@ -207,7 +223,8 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--clock-start", true},
                               {"--status", true},
                               {"--state-dir", true},
-                              {"--no-resume"}});
+                              {"--no-resume"},
+                              {"--strict"}});
   if (!parsed) return std::unexpected(parsed.error());
   RunOptions run;
   for (const ParsedOption& o : *parsed) {
@@ -331,6 +348,8 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       run.stateDir = std::filesystem::path(o.value);
     } else if (o.name == "--no-resume") {
       run.resume = false;
+    } else if (o.name == "--strict") {
+      run.strict = true;
     }
   }
   for (const auto& [name, zoom] : run.zooms) {
@@ -381,21 +400,104 @@ render::OutputKind toRenderKind(OutputKind kind) {
 
 /// Reads and validates the manifest (the files it names must exist inside the show folder; their
 /// contents are read as the show loads them, and `basalt check` parses them all beforehand);
-/// prints its errors and warnings.
-std::optional<Manifest> readShowManifest(const std::filesystem::path& file) {
+/// prints its errors and warnings. The errors are added to `errors` ("file:line: message").
+std::optional<Manifest> readShowManifest(const std::filesystem::path& file, bool strict,
+                                         std::vector<std::string>& errors) {
   Diagnostics diagnostics;
   auto manifest = readManifest(file, diagnostics);
   for (const Diagnostic& d : diagnostics.items()) {
     if (d.severity != Severity::kNote) fmt::print(stderr, "{}\n", d.format());
+    if (d.severity == Severity::kError) errors.push_back(d.format());
   }
   if (!manifest) {
-    fmt::print(stderr,
-               "basalt: error: cannot start: {} has {} problem{} (above); 'basalt check {}' lists them without "
-               "starting\n",
-               file.string(), diagnostics.errorCount(), diagnostics.errorCount() == 1 ? "" : "s", file.string());
+    fmt::print(stderr, "basalt: error: {}{} has {} problem{} (above); 'basalt check {}' lists them without starting\n",
+               strict ? "cannot start: " : "", file.string(), diagnostics.errorCount(),
+               diagnostics.errorCount() == 1 ? "" : "s", file.string());
   }
   return manifest;
 }
+
+/// This node's addresses beside its name ("kiosk-3 (192.168.1.20, fe80::1)"), for the problem
+/// card: what a technician types to reach its status page.
+std::string nodeAddress() {
+  std::array<char, 256> name{};
+  std::string out = ::gethostname(name.data(), name.size() - 1) == 0 ? std::string(name.data()) : "this node";
+  std::vector<std::string> addresses;
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) == 0) {
+    for (const ifaddrs* a = list; a; a = a->ifa_next) {
+      if (!a->ifa_addr || (a->ifa_flags & IFF_LOOPBACK) || !(a->ifa_flags & IFF_UP)) continue;
+      std::array<char, INET6_ADDRSTRLEN> text{};
+      const int family = a->ifa_addr->sa_family;
+      const void* raw = nullptr;
+      if (family == AF_INET) raw = &reinterpret_cast<const sockaddr_in*>(a->ifa_addr)->sin_addr;
+      if (family == AF_INET6) raw = &reinterpret_cast<const sockaddr_in6*>(a->ifa_addr)->sin6_addr;
+      if (raw && ::inet_ntop(family, raw, text.data(), text.size())) addresses.emplace_back(text.data());
+    }
+    ::freeifaddrs(list);
+  }
+  return addresses.empty() ? out + " (no network address)" : fmt::format("{} ({})", out, fmt::join(addresses, ", "));
+}
+
+/// What plays when the show has errors (and --strict is not given): its last good copy, or the
+/// problem card. `problems` says what is wrong, for the log and /health.
+struct Fallback {
+  Manifest manifest;
+  std::vector<std::string> problems;
+  bool card = false;
+};
+
+Fallback fallBack(const RunOptions& options, std::vector<std::string> errors, bool tryCopy = true) {
+  const std::filesystem::path original = std::filesystem::absolute(*options.manifest);
+  const std::filesystem::path stateFolder = options.stateDir ? *options.stateDir : defaultStateFolder();
+  Fallback f;
+  for (const std::string& e : errors) log::error(kLogRun, "{}", e);
+  if (auto copy = tryCopy ? findLastGood(stateFolder, original) : std::nullopt) {
+    Diagnostics diagnostics;
+    if (auto read = readManifest(copy->manifest, diagnostics)) {
+      f.manifest = std::move(*read);
+      // Reloads re-read the show's own manifest (fixed by then), and it resumes as itself.
+      f.manifest.file = original;
+      f.manifest.status.enabled = true;  // the status page says what is wrong
+      f.problems = std::move(errors);
+      f.problems.push_back(fmt::format("{} has errors: the last good copy from {} plays ({})", original.string(),
+                                       copy->savedAt, copy->manifest.parent_path().string()));
+      log::error(kLogRun, "{} has errors; the last good copy from {} plays instead; fix the show and reload",
+                 original.string(), copy->savedAt);
+      return f;
+    }
+    log::error(kLogRun, "the last good copy {} cannot be read either", copy->manifest.string());
+  }
+  f.card = true;
+  f.manifest = Manifest::builtinDefault();
+  f.manifest.name = "problem card";
+  f.manifest.entry = {EntryKind::kBuiltinBlack, "black", {}, 0};
+  f.manifest.file = original;  // a reload re-reads the show
+  f.manifest.kiosk.resume = false;
+  f.manifest.status.enabled = true;  // the technician's way in: the default 127.0.0.1:8180 unless --status
+  f.problems = std::move(errors);
+  f.problems.push_back(fmt::format("{} has errors and there is no last good copy: the problem card shows; node {}",
+                                   original.string(), nodeAddress()));
+  log::error(kLogRun, "{}", f.problems.back());
+  return f;
+}
+
+/// The problem card: an amber screen while the show that should play has errors and no last good
+/// copy (Basalt draws no text; the status page and /health say what is wrong). It goes once a
+/// reload brings the fixed show.
+class ProblemCard final : public FrameParticipant {
+ public:
+  ProblemCard(runtime::Show& show, const ShowDirector& director) : show_(show), director_(director) {}
+  Result<void> beforeDraw(const FrameContext& /*frame*/) override {
+    if (director_.reloadsApplied() == 0) show_.global().background = kAmber;
+    return {};
+  }
+  static constexpr runtime::Color3 kAmber{1.0f, 0.6f, 0.0f};
+
+ private:
+  runtime::Show& show_;
+  const ShowDirector& director_;
+};
 
 /// "127.0.0.1:8180" or "[::1]:0" into the status spec.
 Result<void> applyStatusListen(std::string_view listen, StatusSpec& spec) {
@@ -447,10 +549,18 @@ std::string hostName() {
 
 int runShow(const RunOptions& options) {
   Manifest manifest = Manifest::builtinDefault();
+  std::optional<Fallback> fallback;  // the show has errors: its last good copy or the card plays
   if (options.manifest) {
-    auto read = readShowManifest(*options.manifest);
-    if (!read) return 1;
-    manifest = std::move(*read);
+    std::vector<std::string> errors;
+    auto read = readShowManifest(*options.manifest, options.strict, errors);
+    if (read) {
+      manifest = std::move(*read);
+    } else if (options.strict) {
+      return 1;
+    } else {
+      fallback = fallBack(options, std::move(errors));
+      manifest = fallback->manifest;
+    }
   }
   if (stderrIsJournal()) logToJournal(manifest.name);
 
@@ -587,7 +697,25 @@ int runShow(const RunOptions& options) {
   // Texture images are read in the background: the first frame does not wait for them.
   ShowFactories factories = showFactories();
   auto loaded = loadShow(manifest, clock, factories, false);
+  if (!loaded && options.manifest && !options.strict && !(fallback && fallback->card)) {
+    // The entry has errors (a script that does not parse): the last good copy plays, or the card.
+    const std::string error = loaded.error().describe();
+    fmt::print(stderr, "basalt: error: cannot load the show: {}\n", error);
+    const StatusSpec status = manifest.status;  // the manifest itself was good: its [status] holds
+    fallback = fallBack(options, {error});
+    manifest = fallback->manifest;
+    loaded = loadShow(manifest, clock, factories, false);
+    if (!loaded) {
+      fallback =
+          fallBack(options, {error, "its last good copy cannot load either: " + loaded.error().describe()}, false);
+      manifest = fallback->manifest;
+      loaded = loadShow(manifest, clock, factories, false);
+    }
+    manifest.status = status;
+    manifest.status.enabled = true;
+  }
   if (!loaded) return failWith(loaded.error(), "cannot load the show");
+  if (fallback) board.setProblems(fallback->problems);
 
   runtime::Show show;
   FrameLoop frameLoop({fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output, **renderer);
@@ -595,6 +723,20 @@ int runShow(const RunOptions& options) {
       DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps},
       std::move(factories));
   director.install(std::move(*loaded), clock.now(), resume);
+  // The show started cleanly: keep it as the last good copy, in the background (the first
+  // frame does not wait for the copy).
+  std::jthread keeper;
+  if (options.manifest && !fallback) {
+    keeper = std::jthread([stateFolder = options.stateDir ? *options.stateDir : defaultStateFolder(),
+                           file = manifest.file, folder = manifest.folder] {
+      auto kept = keepLastGood(stateFolder, file, folder);
+      if (!kept) {
+        log::warn(kLogRun, "cannot keep the last good copy of the show: {}", kept.error().describe());
+      } else if (*kept == KeptCopy::kWritten) {
+        log::info(kLogRun, "kept the show as its last good copy in {}", lastGoodFolder(stateFolder, file).string());
+      }
+    });
+  }
   // Keyboards and mice where no window delivers them (KMS): read from evdev on a thread of their
   // own, taken by the director each frame the way a window's keys are.
   std::unique_ptr<devices::EvdevInput> keyboardsAndMice;
@@ -669,6 +811,11 @@ int runShow(const RunOptions& options) {
   FrameMetrics metrics(board, &events, (*output)->describe());
   frameLoop.addParticipant(metrics);
   frameLoop.addParticipant(director);
+  std::optional<ProblemCard> card;
+  if (fallback && fallback->card) {
+    card.emplace(show, director);
+    frameLoop.addParticipant(*card);
+  }
   frameLoop.addParticipant(*supervisor);
 
   std::optional<ScriptPlayer> player;

@@ -72,6 +72,8 @@ std::string jsonString(std::string_view text) {
 }
 
 std::string_view overallState(const StatusSnapshot& s) {
+  // The show's own errors (at start, or at a failed reload) come first.
+  if (!s.problems.empty()) return "degraded";
   for (const DeviceStatus& d : s.devices) {
     // "idle": a camera no texture shows (a script may open it); nothing is wrong with it.
     if (d.state != "live" && d.state != "idle") return "degraded";
@@ -159,6 +161,11 @@ std::string healthJson(const StatusSnapshot& s) {
   out += s.streams.empty() ? "],\n" : "\n  ],\n";
   out += fmt::format("  \"reloads\": {{\"total\": {}, \"failed\": {}, \"last\": {}}},\n", s.reloads, s.reloadFailures,
                      jsonString(s.lastReload));
+  out += "  \"problems\": [";
+  for (std::size_t i = 0; i < s.problems.size(); ++i) {
+    out += fmt::format("{}\n    {}", i ? "," : "", jsonString(s.problems[i]));
+  }
+  out += s.problems.empty() ? "],\n" : "\n  ],\n";
   out += fmt::format("  \"errors_logged\": {},\n", s.errorsLogged);
   out += "  \"last_errors\": [";
   for (std::size_t i = 0; i < s.lastErrors.size(); ++i) {
@@ -370,6 +377,7 @@ std::string_view statusPageHtml() {
   #state.ok { background: #1f8a3a; }
   #state.degraded { background: #c27c0e; }
   #state.down { background: #b3261e; }
+  #problems { white-space: pre-line; padding: 8px 10px; border-left: 4px solid #c27c0e; background: #3a2a0a; }
   main { padding: 12px 16px; display: grid; gap: 14px; }
   section { background: #1d2027; border-radius: 10px; padding: 12px; }
   h2 { font-size: 15px; margin: 0 0 8px; color: #9fb3c8; text-transform: uppercase; letter-spacing: .05em; }
@@ -387,6 +395,7 @@ std::string_view statusPageHtml() {
 </head>
 <body>
 <header><h1 id="show">Basalt</h1><span id="state">…</span></header>
+<p id="problems" hidden></p>
 <main>
   <section><h2>On screen</h2><img id="thumb" alt="the frame on screen now" src="/snapshot.png?w=480">
     <p id="item"></p></section>
@@ -425,6 +434,7 @@ async function refresh() {
     const h = await r.json();
     $("show").textContent = h.show.name || "Basalt";
     $("state").textContent = h.state; $("state").className = h.state;
+    $("problems").hidden = !h.problems.length; $("problems").textContent = h.problems.join("\n");
     $("item").textContent = h.show.description + (h.show.next_schedule_change ? " · schedule changes " + new Date(h.show.next_schedule_change).toLocaleString() : "");
     $("fps").textContent = h.frames.per_second.toFixed(1);
     $("p99").textContent = h.frames.frame_time_ms.p99.toFixed(1);
