@@ -17,6 +17,7 @@
 
 #include "app/commands.h"
 #include "app/options.h"
+#include "app/suggest.h"
 #include "devices/evdev/evdev_input.h"
 #include "kiosk/lock/frame_lock.h"
 #include "kiosk/loop/display_views.h"
@@ -335,8 +336,11 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
     const bool known =
         std::any_of(run.movies.begin(), run.movies.end(), [&](const auto& m) { return m.first == name; });
     if (!known) {
+      std::vector<std::string_view> movies;
+      for (const auto& m : run.movies) movies.emplace_back(m.first);
       return fail(Errc::kInvalidArgument,
-                  fmt::format("--zoom {}: no movie of that name; give --movie {}=FILE too", name, name));
+                  fmt::format("--zoom {}: no movie of that name{}", name,
+                              didYouMean(name, movies, fmt::format("; give --movie {}=FILE too", name))));
     }
   }
   if (run.zoomDials && run.zooms.empty()) {
