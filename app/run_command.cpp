@@ -94,15 +94,44 @@ Result<void> parseSize(std::string_view text, RunOptions& run) {
   return {};
 }
 
+/// A show folder's manifest: DIR/show.toml, or an error that says what the folder holds instead.
+Result<std::filesystem::path> showFolderManifest(const std::filesystem::path& folder) {
+  const std::filesystem::path manifest = folder / "show.toml";
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(manifest, ec)) return manifest;
+  // What could be meant instead: the folder's manifests and scripts (the first few).
+  constexpr std::size_t kListed = 6;
+  std::vector<std::string> shows;
+  std::size_t seen = 0;
+  for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end && seen < 1000; it.increment(ec)) {
+    ++seen;
+    const std::string ext = it->path().extension().string();
+    if (ext == ".toml" || ext == ".mdl") shows.push_back(it->path().filename().string());
+  }
+  std::sort(shows.begin(), shows.end());
+  std::string hint = "give a show manifest (show.toml) or a LAVA script (.mdl)";
+  if (!shows.empty()) {
+    std::string names;
+    for (std::size_t i = 0; i < std::min(shows.size(), kListed); ++i)
+      names += fmt::format("{}{}", i ? ", " : "", shows[i]);
+    if (shows.size() > kListed) names += fmt::format(" and {} more", shows.size() - kListed);
+    hint = fmt::format("it holds {}: give one of them", names);
+  }
+  return fail(Errc::kInvalidArgument,
+              fmt::format("the folder {} has no show.toml (basalt run plays a show folder's show.toml); {}",
+                          folder.string(), hint));
+}
+
 }  // namespace
 
 std::string_view runUsage() {
-  return R"(Usage: basalt run [options] [show.toml | SCRIPT.mdl]
+  return R"(Usage: basalt run [options] [show.toml | SHOW_FOLDER | SCRIPT.mdl]
 
-Plays a show. With a show manifest (show.toml, see configs/shows/) it plays that show: its
-outputs, entry, devices and bindings, textures, kiosk policy (opening hours, attract loop,
-playlist) and status server. With none it plays the default show: LAVA's start-up scene, a
-coloured cube on black, 500x500, turning slowly under LAVA's default lights.
+Plays a show. With a show manifest (show.toml, see configs/shows/), or a show folder that
+holds one (SHOW_FOLDER/show.toml), it plays that show: its outputs, entry, devices and
+bindings, textures, kiosk policy (opening hours, attract loop, playlist) and status server.
+With none it plays the default show: LAVA's start-up scene, a coloured cube on black, 500x500,
+turning slowly under LAVA's default lights.
 The output is the manifest's, or detected: KMS when Basalt can be DRM master (no desktop
 running), a window when a display server is there, offscreen (headless) otherwise; the
 headless output writes a snapshot of the last frame.
@@ -216,7 +245,11 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                                                         (run.manifest ? *run.manifest : *run.show).string()));
       }
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
-      if (o.value.ends_with(".toml")) {
+      if (std::error_code ec; std::filesystem::is_directory(o.value, ec)) {
+        auto manifest = showFolderManifest(o.value);
+        if (!manifest) return std::unexpected(manifest.error());
+        run.manifest = std::move(*manifest);
+      } else if (o.value.ends_with(".toml")) {
         run.manifest = std::filesystem::path(o.value);
       } else {
         run.show = std::filesystem::path(o.value);  // a LAVA script; runShow says if it is not one
