@@ -13,6 +13,7 @@
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 
+#include "sim/hid_comments.h"
 #include "sim/hid_recording.h"
 #include "sim/raw_video.h"
 
@@ -374,12 +375,18 @@ Result<void> TraceRecorder::addDialBox(DeviceId id, const std::string& name, con
   if (!f.out) return fail(Errc::kIo, "cannot create the recording file", (folder_ / d.file).string());
   HidRecordedDevice header;
   header.name = info.name;
+  header.phys = hidPhysicalPath(info);
   header.bus = info.bus == "usb" ? 3 : (info.bus == "bluetooth" ? 5 : 6);
   header.vendor = info.vendor;
   header.product = info.product;
   header.descriptor = descriptor;
+  // As hid-recorder begins: the name, then the descriptor item by item, then the R: N: P: I:
+  // lines; each report's E: line comes after a comment that decodes it.
+  f.comments = HidComments::create(descriptor);
+  f.out << "# " << info.name << "\n";
   f.out << "# Recorded by " << options_.basaltVersion << " (basalt record) from " << devices::describeDevice(info)
         << "\n";
+  f.out << f.comments.descriptorLines();
   f.out << HidRecordingWriter::header(header, false);
   f.index = info_.devices.size();
   info_.devices.push_back(std::move(d));
@@ -411,7 +418,7 @@ void TraceRecorder::onReport(DeviceId device, Nanos time, std::span<const std::u
   if (stopping_) return;
   auto it = dials_.find(device);
   if (it == dials_.end()) return;
-  it->second.out << HidRecordingWriter::reportLine(time - start_, report);
+  it->second.out << it->second.comments.reportLine(report) << HidRecordingWriter::reportLine(time - start_, report);
   if (!it->second.out)
     noteError(Error(Errc::kIo, "cannot write the recording (disk full?)", info_.devices[it->second.index].file));
   ++reports_;

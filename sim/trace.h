@@ -24,6 +24,7 @@
 #include "devices/video_source.h"
 #include "runtime/clock.h"
 #include "runtime/error.h"
+#include "sim/hid_comments.h"
 #include "sim/trace_video.h"
 
 namespace basalt::sim {
@@ -104,6 +105,7 @@ class TraceRecorder final : public devices::ReportTap, public devices::FrameTap 
   struct DialFile {
     std::ofstream out;
     std::size_t index = 0;  // in info_.devices
+    HidComments comments;   // decodes each report into the comment before its E: line
   };
   struct VideoFile {
     std::unique_ptr<TraceVideoWriter> writer;
