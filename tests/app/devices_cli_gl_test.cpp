@@ -90,7 +90,7 @@ TEST(DevicesCli, RecordedTraceReplaysBitForBit) {
   EXPECT_TRUE(std::filesystem::exists(raw / "camera.bvraw")) << "--raw-video keeps the uncompressed format";
   r = runBasalt({"record", "--synthetic", "--fast", "--seconds", "1", "--output", trace.string()});
   EXPECT_EQ(r.exitCode, 1) << "recording over a trace must be refused";
-  EXPECT_NE(r.output.find("not empty"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("holds a finished trace"), std::string::npos) << r.output;
 
   const auto probe = runBasalt({"run", "--frames", "1", "--headless", "--snapshot", (dir / "probe.png").string()});
   if (probe.exitCode != 0) GTEST_SKIP() << "no headless EGL here: " << probe.output;
