@@ -17,6 +17,7 @@
 
 #include "app/commands.h"
 #include "app/options.h"
+#include "app/replay_report.h"
 #include "app/suggest.h"
 #include "devices/evdev/evdev_input.h"
 #include "kiosk/lock/frame_lock.h"
@@ -742,12 +743,14 @@ int runShow(const RunOptions& options) {
                      {runtime::Action::kMoveZoomY, static_cast<double>(size.height)});
     videos->followZoomDials(&bindings);
   }
+  std::optional<ReplayReport> replayed;  // what the replay played, said once at the end (outlives `devices`)
   std::unique_ptr<DeviceWiring> devices;
   if (options.replay) {
     devices = std::make_unique<DeviceWiring>(clock, [eventLoop] { eventLoop->wake(); });
     if (auto r = devices->addReplay(*options.replay, !options.replayOnce, matroskaTraceReaderFactory()); !r) {
       return failWith(r.error(), "cannot replay");
     }
+    devices->manager().setTaps(&replayed.emplace(*options.replay, clock), &*replayed);
     frameLoop.addParticipant(devices->participant());
     frameLoop.setEvents(&devices->events(), &bindings);
     devices->start(manual);
@@ -827,6 +830,7 @@ int runShow(const RunOptions& options) {
   std::vector<devices::DeviceStatus> deviceStatus;
   if (devices) {
     deviceStatus = devices->manager().status();
+    devices->manager().setTaps(nullptr, nullptr);
     devices->stop();
   }
   supervisor->stopping();
@@ -876,12 +880,7 @@ int runShow(const RunOptions& options) {
                  recorder->describe());
     }
   }
-  if (devices) {
-    for (const devices::DeviceStatus& s : deviceStatus) {
-      fmt::print("basalt: replayed {} '{}' ({})\n", devices::deviceKindName(s.kind), s.name,
-                 s.lastError.empty() ? std::string(devices::deviceStateName(s.state)) : s.lastError);
-    }
-  }
+  if (replayed) fmt::print("basalt: {}\n", replayed->summary(deviceStatus));
   std::fflush(stdout);
   return status;
 }
