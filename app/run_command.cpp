@@ -23,7 +23,9 @@
 
 #include "app/commands.h"
 #include "app/options.h"
+#include "app/replay_report.h"
 #include "app/show_factories.h"
+#include "app/suggest.h"
 #include "devices/evdev/evdev_input.h"
 #include "kiosk/lock/frame_lock.h"
 #include "kiosk/loop/display_views.h"
@@ -100,15 +102,44 @@ Result<void> parseSize(std::string_view text, RunOptions& run) {
   return {};
 }
 
+/// A show folder's manifest: DIR/show.toml, or an error that says what the folder holds instead.
+Result<std::filesystem::path> showFolderManifest(const std::filesystem::path& folder) {
+  const std::filesystem::path manifest = folder / "show.toml";
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(manifest, ec)) return manifest;
+  // What could be meant instead: the folder's manifests and scripts (the first few).
+  constexpr std::size_t kListed = 6;
+  std::vector<std::string> shows;
+  std::size_t seen = 0;
+  for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end && seen < 1000; it.increment(ec)) {
+    ++seen;
+    const std::string ext = it->path().extension().string();
+    if (ext == ".toml" || ext == ".mdl") shows.push_back(it->path().filename().string());
+  }
+  std::sort(shows.begin(), shows.end());
+  std::string hint = "give a show manifest (show.toml) or a LAVA script (.mdl)";
+  if (!shows.empty()) {
+    std::string names;
+    for (std::size_t i = 0; i < std::min(shows.size(), kListed); ++i)
+      names += fmt::format("{}{}", i ? ", " : "", shows[i]);
+    if (shows.size() > kListed) names += fmt::format(" and {} more", shows.size() - kListed);
+    hint = fmt::format("it holds {}: give one of them", names);
+  }
+  return fail(Errc::kInvalidArgument,
+              fmt::format("the folder {} has no show.toml (basalt run plays a show folder's show.toml); {}",
+                          folder.string(), hint));
+}
+
 }  // namespace
 
 std::string_view runUsage() {
-  return R"(Usage: basalt run [options] [show.toml | SCRIPT.mdl]
+  return R"(Usage: basalt run [options] [show.toml | SHOW_FOLDER | SCRIPT.mdl]
 
-Plays a show. With a show manifest (show.toml, see configs/shows/) it plays that show: its
-outputs, entry, devices and bindings, textures, kiosk policy (opening hours, attract loop,
-playlist) and status server. With none it plays the default show: LAVA's start-up scene, a
-coloured cube on black, 500x500, turning slowly under LAVA's default lights.
+Plays a show. With a show manifest (show.toml, see configs/shows/), or a show folder that
+holds one (SHOW_FOLDER/show.toml), it plays that show: its outputs, entry, devices and
+bindings, textures, kiosk policy (opening hours, attract loop, playlist) and status server.
+With none it plays the default show: LAVA's start-up scene, a coloured cube on black, 500x500,
+turning slowly under LAVA's default lights.
 The output is the manifest's, or detected: KMS when Basalt can be DRM master (no desktop
 running), a window when a display server is there, offscreen (headless) otherwise; the
 headless output writes a snapshot of the last frame.
@@ -234,7 +265,11 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                                                         (run.manifest ? *run.manifest : *run.show).string()));
       }
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
-      if (o.value.ends_with(".toml")) {
+      if (std::error_code ec; std::filesystem::is_directory(o.value, ec)) {
+        auto manifest = showFolderManifest(o.value);
+        if (!manifest) return std::unexpected(manifest.error());
+        run.manifest = std::move(*manifest);
+      } else if (o.value.ends_with(".toml")) {
         run.manifest = std::filesystem::path(o.value);
       } else {
         run.show = std::filesystem::path(o.value);  // a LAVA script; runShow says if it is not one
@@ -356,8 +391,11 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
     const bool known =
         std::any_of(run.movies.begin(), run.movies.end(), [&](const auto& m) { return m.first == name; });
     if (!known) {
+      std::vector<std::string_view> movies;
+      for (const auto& m : run.movies) movies.emplace_back(m.first);
       return fail(Errc::kInvalidArgument,
-                  fmt::format("--zoom {}: no movie of that name; give --movie {}=FILE too", name, name));
+                  fmt::format("--zoom {}: no movie of that name{}", name,
+                              didYouMean(name, movies, fmt::format("; give --movie {}=FILE too", name))));
     }
   }
   if (run.zoomDials && run.zooms.empty()) {
@@ -798,11 +836,13 @@ int runShow(const RunOptions& options) {
   // through LAVA's dial table (and the Zoom dials, below). Its stepper comes before the director,
   // so that under a ManualClock what it has due by a frame is applied in that frame.
   runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  std::optional<ReplayReport> replayed;  // what the replay played, said once at the end (outlives `devices`)
   std::unique_ptr<DeviceWiring> devices;
   if (options.replay) {
     devices = std::make_unique<DeviceWiring>(clock, events, kReplayFirstId);
     auto ids = devices->addReplay(*options.replay, !options.replayOnce, matroskaTraceReaderFactory());
     if (!ids) return failWith(ids.error(), "cannot replay");
+    devices->manager().setTaps(&replayed.emplace(*options.replay, clock), &*replayed);
     director.setReplayInput(&bindings, std::move(*ids));
     frameLoop.addParticipant(devices->participant());
     devices->start(manual);
@@ -951,6 +991,7 @@ int runShow(const RunOptions& options) {
   std::vector<devices::DeviceStatus> deviceStatus;
   if (devices) {
     deviceStatus = devices->manager().status();
+    devices->manager().setTaps(nullptr, nullptr);
     devices->stop();
   }
   supervisor->stopping();
@@ -1000,12 +1041,7 @@ int runShow(const RunOptions& options) {
                  recorder->describe());
     }
   }
-  if (devices) {
-    for (const devices::DeviceStatus& s : deviceStatus) {
-      fmt::print("basalt: replayed {} '{}' ({})\n", devices::deviceKindName(s.kind), s.name,
-                 s.lastError.empty() ? std::string(devices::deviceStateName(s.state)) : s.lastError);
-    }
-  }
+  if (replayed) fmt::print("basalt: {}\n", replayed->summary(deviceStatus));
   std::fflush(stdout);
   return status;
 }
