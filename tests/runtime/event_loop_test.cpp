@@ -9,7 +9,10 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <cstdlib>
+#include <string_view>
 #include <thread>
+#include <vector>
 
 #include "runtime/event_loop.h"
 
@@ -66,6 +69,62 @@ TEST(EventLoop, SystemClockTimerWakesTheWait) {
   (*loop)->addTimer(clock.now() + std::chrono::milliseconds(5), [&] { fired = true; });
   for (int i = 0; i < 100 && !fired; ++i) ASSERT_TRUE((*loop)->dispatch(std::chrono::milliseconds(50)));
   EXPECT_TRUE(fired);
+}
+
+// A wait shorter than a millisecond must not come back at once: epoll_pwait counts whole
+// milliseconds, and a timeout rounded down to 0 would make the frame loop spin.
+TEST(EventLoop, ShortWaitIsNotCutShort) {
+  SystemClock clock;
+  auto loop = EventLoop::create(clock);
+  ASSERT_TRUE(loop);
+  for (const Nanos wait : {Nanos{600'000}, Nanos{1'500'000}, Nanos{2'000'001}}) {
+    const Nanos start = clock.now();
+    ASSERT_TRUE((*loop)->dispatch(wait));
+    EXPECT_GE(clock.now() - start, wait) << "a wait of " << wait.count() << " ns came back early";
+  }
+}
+
+// Timers with sub-millisecond deadlines fire at or after them, never before, and waiting for
+// them takes few dispatches (a spinning wait would take thousands).
+TEST(EventLoop, SystemClockTimersNeverFireEarly) {
+  SystemClock clock;
+  auto loop = EventLoop::create(clock);
+  ASSERT_TRUE(loop);
+  const Nanos start = clock.now();
+  const std::vector<Nanos> offsets{Nanos{1'300'000}, Nanos{2'700'000}, Nanos{4'100'000}, Nanos{20'400'000}};
+  std::vector<Nanos> firedAt(offsets.size(), Nanos{-1});
+  for (std::size_t i = 0; i < offsets.size(); ++i) {
+    (*loop)->addTimer(start + offsets[i], [&, i] { firedAt[i] = clock.now(); });
+  }
+  int dispatches = 0;
+  while (firedAt.back() < Nanos{0} && dispatches < 10'000) {
+    ASSERT_TRUE((*loop)->dispatch(Nanos{600'000}));
+    ++dispatches;
+  }
+  for (std::size_t i = 0; i < offsets.size(); ++i) {
+    ASSERT_GE(firedAt[i], Nanos{0}) << "timer " << i << " never fired";
+    EXPECT_GE(firedAt[i], start + offsets[i]) << "timer " << i << " fired early";
+    EXPECT_LT(firedAt[i], start + offsets[i] + std::chrono::milliseconds(200)) << "timer " << i << " fired late";
+  }
+  // 20.4 ms in waits of at most 0.6 ms (1 ms with epoll_pwait) is 35 dispatches, plus the
+  // timers' own wake-ups; a wait rounded down to nothing would loop thousands of times.
+  EXPECT_LE(dispatches, 60);
+}
+
+// ctest runs this binary's EventLoop tests a second time with BASALT_NO_EPOLL_PWAIT2=1 (the
+// EpollPwaitFallback. tests): the loop must then wait with epoll_pwait.
+TEST(EventLoop, WaitCallFollowsTheEnvironment) {
+  SystemClock clock;
+  auto loop = EventLoop::create(clock);
+  ASSERT_TRUE(loop);
+  ASSERT_TRUE((*loop)->dispatch(Nanos{0}));
+  const char* forced = std::getenv("BASALT_NO_EPOLL_PWAIT2");
+  const std::string_view used = EventLoop::waitCallName();
+  if (forced != nullptr && std::string_view(forced) == "1") {
+    EXPECT_EQ(used, "epoll_pwait");
+  } else {
+    EXPECT_TRUE(used == "epoll_pwait2" || used == "epoll_pwait") << used;
+  }
 }
 
 TEST(EventLoop, WakeFromAnotherThreadEndsTheWait) {
