@@ -13,6 +13,7 @@
 
 #include <fstream>
 #include <string>
+#include <vector>
 #include <thread>
 
 #include "kiosk/manifest/content_check.h"
@@ -208,6 +209,78 @@ TEST(ManifestErrors, NonAsciiInStringsAndCommentsIsFine) {
       "e d'Orsay, salle \xE2\x84\x96 3\n[show]\nname = '''Caf\xC3\xA9 ''\xC3\xA9'''\n"
       "[\"status\"]\nlisten = \"127.0.0.1:0\" # \xC2\xA1ok!\n");
   EXPECT_TRUE(r.manifest) << r.text;
+}
+
+// The fuzzing reproducer `i=8'` then U+046F: the quote follows a number, so it starts no string
+// (toml++ reads it as part of the number token), and the Cyrillic letter after it reached
+// toml++'s whitespace test, which has undefined behaviour for U+00A1..U+0499.
+TEST(ManifestErrors, QuoteThatStartsNoStringLeavesNonAsciiOutside) {
+  ShowFolder f("toml-quote-after-token");
+  const auto r = f.read("i=8'\xD1\xAF");
+  EXPECT_FALSE(r.manifest);
+  EXPECT_TRUE(hasError(r, 1, "non-ASCII character at column 5 outside quotes")) << r.text;
+
+  // After a string that ended, after a number's dot, after a bare key: no string starts.
+  const auto afterString = f.read("[show]\nname = 'a''\xC3\xA9'\n");
+  EXPECT_FALSE(afterString.manifest);
+  EXPECT_TRUE(hasError(afterString, 2, "non-ASCII character at column 12 outside quotes")) << afterString.text;
+  const auto afterDot = f.read("[show]\nfps = 1.'\xC3\xA9'\n");
+  EXPECT_FALSE(afterDot.manifest);
+  EXPECT_TRUE(hasError(afterDot, 2, "non-ASCII character at column 10 outside quotes")) << afterDot.text;
+  const auto afterKey = f.read("[show]\nname'\xC3\xA9' = 1\n");
+  EXPECT_FALSE(afterKey.manifest);
+  EXPECT_TRUE(hasError(afterKey, 2, "non-ASCII character at column 6 outside quotes")) << afterKey.text;
+}
+
+// Strings cut off by the end of the file right after a multibyte character: a clear TOML
+// error from toml++ (the text is valid UTF-8 and the character is inside the string).
+TEST(ManifestErrors, UnterminatedStringsEndingInMultibyteAreTomlErrors) {
+  ShowFolder f("toml-unterminated");
+  for (const std::string open : {"'", "\"", "'''", "\"\"\""}) {
+    for (const std::string tail : {"\xD1\xAF", "Caf\xC3\xA9", "\xE3\x80\x80", "\xF0\x9F\x8E\xA5"}) {
+      const auto r = f.read("[show]\nname = " + open + tail);
+      EXPECT_FALSE(r.manifest) << open << tail;
+      EXPECT_TRUE(hasError(r, 2, "not valid TOML")) << open << tail << ": " << r.text;
+    }
+  }
+}
+
+TEST(ManifestErrors, InvalidUtf8NamesLineAndColumn) {
+  ShowFolder f("toml-utf8");
+  struct Case {
+    std::string text;
+    int line;
+    std::string needle;
+  };
+  const std::vector<Case> cases = {
+      // Cut short by the end of the file, inside a literal string (column 10: n,a,m,e, ,=, ,',x).
+      {"[show]\nname = 'x\xD1", 2, "not valid UTF-8 at column 10: the file ends inside a UTF-8 character"},
+      {"[show]\nname = 'x\xF0\x9F\x8E", 2, "not valid UTF-8 at column 10: the file ends inside"},
+      // A continuation byte with no lead byte, in a comment after two-byte characters.
+      {"# \xC3\xA9\xC3\xA9\x80\n[show]\n", 1, "not valid UTF-8 at column 5: byte 0x80 cannot start"},
+      // An overlong '/' (C0 AF), a UTF-16 surrogate (ED A0 80), a code point above U+10FFFF.
+      {"[show]\n# \xC0\xAF\n", 2, "column 3: byte 0xC0 cannot start"},
+      {"[show]\nname = \"\xED\xA0\x80\"\n", 2, "column 9: byte 0xA0 after 0xED is not part of a valid"},
+      {"[show]\nname = \"\xF4\x90\x80\x80\"\n", 2, "column 9: byte 0x90 after 0xF4 is not part of a valid"},
+      // A lead byte followed by ASCII.
+      {"[show]\nname = \"\xC3(\"\n", 2, "column 9: byte 0x28 after 0xC3"},
+  };
+  for (const Case& c : cases) {
+    const auto r = f.read(c.text);
+    EXPECT_FALSE(r.manifest) << c.needle;
+    EXPECT_TRUE(hasError(r, c.line, c.needle)) << c.needle << "\n" << r.text;
+    EXPECT_NE(r.text.find("show.toml:" + std::to_string(c.line) + ": not valid UTF-8"), std::string::npos) << r.text;
+  }
+}
+
+TEST(ManifestErrors, ValidUtf8InStringsAndCommentsIsRead) {
+  ShowFolder f("toml-utf8-valid");
+  // Two-, three- and four-byte characters in a comment and in the show's name.
+  const auto r = f.read(
+      "# \xF0\x9F\x8E\xA5 salle \xE2\x84\x96 3, \xD0\x9C\xD0\xBE\xD1\x81\xD0\xBA\xD0\xB2\xD0\xB0\n"
+      "[show]\nname = \"\xF0\x9F\x8E\xA5 Caf\xC3\xA9 \xD1\xAF\"\n");
+  ASSERT_TRUE(r.manifest) << r.text;
+  EXPECT_EQ(r.manifest->name, "\xF0\x9F\x8E\xA5 Caf\xC3\xA9 \xD1\xAF");
 }
 
 TEST(ManifestErrors, MissingManifestIsOneMessage) {
