@@ -22,7 +22,7 @@ CheckResult checkManifestFile(const std::filesystem::path& file) {
     result.diagnostics.push_back({Severity::kError, file, 0, "the manifest could not be read"});
   }
   if (const std::size_t errors = result.errors(); errors > 0 || !manifest) {
-    result.verdict = fmt::format("the show will not start until {} fixed", errors == 1 ? "it is" : "they are");
+    result.verdict = fmt::format("its last good copy plays until {} fixed", errors == 1 ? "it is" : "they are");
     return result;
   }
   result.verdict = fmt::format(

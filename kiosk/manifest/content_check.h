@@ -23,7 +23,7 @@ struct CheckResult {
   std::vector<Diagnostic> diagnostics;  ///< errors, warnings and notes, in the order found
   std::size_t items = 0;                ///< commands, entries, ... checked (for the summary line)
   /// A checker's last word on the whole file, if it has one: a manifest's "ok: 'Name' plays ..."
-  /// or "the show will not start until it is fixed".
+  /// or "its last good copy plays until it is fixed".
   std::string verdict;
 
   [[nodiscard]] std::size_t errors() const;

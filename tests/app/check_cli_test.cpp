@@ -64,7 +64,7 @@ TEST(CheckCli, TheFileLineCountsWhatIsPrinted) {
   EXPECT_EQ(linesWith(r.output, file + ":5: warning: output:"), 1u) << r.output;
   EXPECT_EQ(linesWith(r.output, ": error: "), 2u) << r.output;
   EXPECT_EQ(linesWith(r.output, ": warning: "), 1u) << r.output;
-  EXPECT_NE(r.output.find("basalt: " + file + ": 2 errors, 1 warning; the show will not start until they are fixed\n"),
+  EXPECT_NE(r.output.find("basalt: " + file + ": 2 errors, 1 warning; its last good copy plays until they are fixed\n"),
             std::string::npos)
       << r.output;
   EXPECT_EQ(r.output.find("problem"), std::string::npos) << "one way of counting: " << r.output;
@@ -108,7 +108,7 @@ TEST(CheckCli, JsonForCi) {
   EXPECT_EQ(first["kind"], "show manifest");
   EXPECT_EQ(first["errors"], 2);
   EXPECT_EQ(first["warnings"], 1);
-  EXPECT_EQ(first["verdict"], "the show will not start until they are fixed");
+  EXPECT_EQ(first["verdict"], "its last good copy plays until they are fixed");
   ASSERT_EQ(first["diagnostics"].size(), 3u) << first.dump(2);
   const int lines[] = {2, 3, 5};
   const char* severities[] = {"error", "error", "warning"};

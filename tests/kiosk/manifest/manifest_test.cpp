@@ -13,8 +13,8 @@
 
 #include <fstream>
 #include <string>
-#include <vector>
 #include <thread>
+#include <vector>
 
 #include "kiosk/manifest/content_check.h"
 #include "kiosk/manifest/manifest.h"
@@ -689,7 +689,7 @@ TEST(CheckCommand, PrintsFileLineMessagesAndFails) {
             std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find(":3: error: devices.x: needs backend"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find(": 2 errors, 0 warnings; the show will not start until they are fixed"), std::string::npos)
+  EXPECT_NE(r.output.find(": 2 errors, 0 warnings; its last good copy plays until they are fixed"), std::string::npos)
       << r.output;
   const auto unknown = test::run({(test::binaryDir() / "basalt").string(), "check", "readme.txt"});
   EXPECT_EQ(unknown.exitCode, 2) << "a file of an unknown kind is a usage error";
