@@ -26,7 +26,7 @@ namespace basalt::kiosk {
 
 namespace {
 
-constexpr std::uint64_t kMiB = 1024 * 1024;
+constexpr std::uint64_t kMiB = std::uint64_t{1024} * 1024;
 /// What `basalt record` keeps free on the disk it writes to, unless --keep-free says otherwise.
 constexpr std::uint64_t kDefaultKeepFree = 256 * kMiB;
 
@@ -63,7 +63,7 @@ Result<std::uint64_t> parseSizeOption(std::string_view option, std::string_view 
   } else if (unit == "G") {
     scale = 1024 * kMiB;
   } else if (unit == "T") {
-    scale = 1024 * 1024 * kMiB;
+    scale = kMiB * 1024 * 1024;
   } else if (!unit.empty() && unit != "B") {
     return bad();
   }

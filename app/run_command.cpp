@@ -104,7 +104,7 @@ Result<void> parseSize(std::string_view text, RunOptions& run) {
 
 /// A show folder's manifest: DIR/show.toml, or an error that says what the folder holds instead.
 Result<std::filesystem::path> showFolderManifest(const std::filesystem::path& folder) {
-  const std::filesystem::path manifest = folder / "show.toml";
+  std::filesystem::path manifest = folder / "show.toml";
   std::error_code ec;
   if (std::filesystem::is_regular_file(manifest, ec)) return manifest;
   // What could be meant instead: the folder's manifests and scripts (the first few).
@@ -392,6 +392,7 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
         std::any_of(run.movies.begin(), run.movies.end(), [&](const auto& m) { return m.first == name; });
     if (!known) {
       std::vector<std::string_view> movies;
+      movies.reserve(run.movies.size());
       for (const auto& m : run.movies) movies.emplace_back(m.first);
       return fail(Errc::kInvalidArgument,
                   fmt::format("--zoom {}: no movie of that name{}", name,
