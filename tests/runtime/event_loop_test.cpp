@@ -93,7 +93,8 @@ TEST(EventLoop, ShortWaitIsNotCutShort) {
 }
 
 // Timers with sub-millisecond deadlines fire at or after them, never before, and waiting for
-// them takes few dispatches (a spinning wait would take thousands).
+// them takes few dispatches (a spinning wait would take thousands). How late they fire is not
+// asserted: on a loaded machine that is the scheduler's, not the loop's.
 TEST(EventLoop, SystemClockTimersNeverFireEarly) {
   SystemClock clock;
   auto loop = EventLoop::create(clock);
@@ -112,7 +113,6 @@ TEST(EventLoop, SystemClockTimersNeverFireEarly) {
   for (std::size_t i = 0; i < offsets.size(); ++i) {
     ASSERT_GE(firedAt[i], Nanos{0}) << "timer " << i << " never fired";
     EXPECT_GE(firedAt[i], start + offsets[i]) << "timer " << i << " fired early";
-    EXPECT_LT(firedAt[i], start + offsets[i] + std::chrono::milliseconds(200)) << "timer " << i << " fired late";
   }
   // 20.4 ms in waits of at most 0.6 ms (1 ms with epoll_pwait) is 35 dispatches, plus the
   // timers' own wake-ups; a wait rounded down to nothing would loop thousands of times.
