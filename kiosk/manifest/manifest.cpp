@@ -396,8 +396,8 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
     switch (previous) {
       case '=':
       case ',':
-      case '{': return true;
-      case '[': return true;        // a table header's key or an array's first value
+      case '{':
+      case '[': return true;        // '[': a table header's key or an array's first value
       case '.': return keyContext;  // a dotted key; after a digit, a number goes on
       case '\n': return true;       // a key at the start of a line
       default: return false;
