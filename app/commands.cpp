@@ -1,6 +1,7 @@
 #include "app/commands.h"
 
 #include <cstdio>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -8,6 +9,7 @@
 #include "app/devices_command.h"
 #include "app/record_command.h"
 #include "app/run_command.h"
+#include "app/suggest.h"
 #include "runtime/script/reference.h"
 
 namespace basalt::kiosk {
@@ -24,6 +26,16 @@ constexpr CommandSpec kCommands[] = {
 };
 
 constexpr std::string_view kVersion = "basalt 0.1.0";
+
+/// "unknown command 'rnu'; did you mean 'run'?" (`basalt rnu`), or "no command 'rnu'; ..."
+/// (`basalt help rnu`, where "script" is a topic too).
+int unknownCommand(std::string_view name, bool asHelpTopic) {
+  std::vector<std::string_view> names;
+  for (const CommandSpec& c : kCommands) names.push_back(c.name);
+  names.emplace_back(asHelpTopic ? "script" : "help");
+  return usageError(fmt::format("{} '{}'{}", asHelpTopic ? "no command" : "unknown command", name,
+                                didYouMean(name, names, "; see 'basalt --help'")));
+}
 
 }  // namespace
 
@@ -77,13 +89,17 @@ int dispatch(std::span<const std::string_view> args) {
         return 0;
       }
     }
-    return usageError(fmt::format("no command '{}'; see 'basalt --help'", args[1]));
+    return unknownCommand(args[1], true);
   }
   for (const CommandSpec& c : kCommands) {
     if (c.name == args[0]) return c.main(args.subspan(1));
   }
-  if (args[0].starts_with("-")) return usageError(fmt::format("unknown option '{}'; see 'basalt --help'", args[0]));
-  return usageError(fmt::format("unknown command '{}'; see 'basalt --help'", args[0]));
+  if (args[0].starts_with("-")) {
+    constexpr std::string_view kOptions[] = {"--help", "--version"};
+    return usageError(
+        fmt::format("unknown option '{}'{}", args[0], didYouMean(args[0], kOptions, "; see 'basalt --help'")));
+  }
+  return unknownCommand(args[0], false);
 }
 
 }  // namespace basalt::kiosk

@@ -2,8 +2,11 @@
 
 #include <charconv>
 #include <cmath>
+#include <vector>
 
 #include <fmt/format.h>
+
+#include "app/suggest.h"
 
 namespace basalt::kiosk {
 
@@ -51,8 +54,11 @@ Result<std::vector<ParsedOption>> parseOptions(std::string_view command, std::sp
       if (matches(s.name, name)) spec = &s;
     }
     if (!spec) {
+      std::vector<std::string_view> known;
+      for (const OptionSpec& s : specs) known.push_back(canonical(s.name));
       return fail(Errc::kInvalidArgument,
-                  fmt::format("unknown option '{}' for 'basalt {}'; see 'basalt {} --help'", name, command, command));
+                  fmt::format("unknown option '{}' for 'basalt {}'{}", name, command,
+                              didYouMean(name, known, fmt::format("; see 'basalt {} --help'", command))));
     }
     if (!spec->takesValue) {
       if (inlineValue) {

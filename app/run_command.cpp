@@ -1,5 +1,9 @@
 #include "app/run_command.h"
 
+#include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <net/if.h>
+#include <netinet/in.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -9,23 +13,28 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <system_error>
+#include <thread>
 
 #include <fmt/format.h>
 #include <fmt/std.h>
 
 #include "app/commands.h"
 #include "app/options.h"
+#include "app/replay_report.h"
+#include "app/show_factories.h"
+#include "app/suggest.h"
 #include "devices/evdev/evdev_input.h"
 #include "kiosk/lock/frame_lock.h"
 #include "kiosk/loop/display_views.h"
 #include "kiosk/loop/frame_loop.h"
 #include "kiosk/manifest/manifest.h"
+#include "kiosk/policy/last_good.h"
 #include "kiosk/policy/state_store.h"
 #include "kiosk/policy/supervisor.h"
 #include "kiosk/show/device_wiring.h"
-#include "kiosk/show/readers.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/show_director.h"
 #include "kiosk/show/show_loader.h"
@@ -93,15 +102,44 @@ Result<void> parseSize(std::string_view text, RunOptions& run) {
   return {};
 }
 
+/// A show folder's manifest: DIR/show.toml, or an error that says what the folder holds instead.
+Result<std::filesystem::path> showFolderManifest(const std::filesystem::path& folder) {
+  std::filesystem::path manifest = folder / "show.toml";
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(manifest, ec)) return manifest;
+  // What could be meant instead: the folder's manifests and scripts (the first few).
+  constexpr std::size_t kListed = 6;
+  std::vector<std::string> shows;
+  std::size_t seen = 0;
+  for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end && seen < 1000; it.increment(ec)) {
+    ++seen;
+    const std::string ext = it->path().extension().string();
+    if (ext == ".toml" || ext == ".mdl") shows.push_back(it->path().filename().string());
+  }
+  std::sort(shows.begin(), shows.end());
+  std::string hint = "give a show manifest (show.toml) or a LAVA script (.mdl)";
+  if (!shows.empty()) {
+    std::string names;
+    for (std::size_t i = 0; i < std::min(shows.size(), kListed); ++i)
+      names += fmt::format("{}{}", i ? ", " : "", shows[i]);
+    if (shows.size() > kListed) names += fmt::format(" and {} more", shows.size() - kListed);
+    hint = fmt::format("it holds {}: give one of them", names);
+  }
+  return fail(Errc::kInvalidArgument,
+              fmt::format("the folder {} has no show.toml (basalt run plays a show folder's show.toml); {}",
+                          folder.string(), hint));
+}
+
 }  // namespace
 
 std::string_view runUsage() {
-  return R"(Usage: basalt run [options] [show.toml | SCRIPT.mdl]
+  return R"(Usage: basalt run [options] [show.toml | SHOW_FOLDER | SCRIPT.mdl]
 
-Plays a show. With a show manifest (show.toml, see configs/shows/) it plays that show: its
-outputs, entry, devices and bindings, textures, kiosk policy (opening hours, attract loop,
-playlist) and status server. With none it plays the default show: LAVA's start-up scene, a
-coloured cube on black, 500x500, turning slowly under LAVA's default lights.
+Plays a show. With a show manifest (show.toml, see configs/shows/), or a show folder that
+holds one (SHOW_FOLDER/show.toml), it plays that show: its outputs, entry, devices and
+bindings, textures, kiosk policy (opening hours, attract loop, playlist) and status server.
+With none it plays the default show: LAVA's start-up scene, a coloured cube on black, 500x500,
+turning slowly under LAVA's default lights.
 The output is the manifest's, or detected: KMS when Basalt can be DRM master (no desktop
 running), a window when a display server is there, offscreen (headless) otherwise; the
 headless output writes a snapshot of the last frame.
@@ -148,12 +186,23 @@ Options:
                      hours (2026-12-24T09:59:00Z)
   --status ADDR:PORT serve status and controls there (default: the manifest's [status];
                      port 0 picks a free one)
-  --state-dir DIR    where the show's resume point is kept (default: $STATE_DIRECTORY,
-                     else ~/.local/state/basalt)
+  --state-dir DIR    where the show's resume point and saved calibrations are kept
+                     (default: $STATE_DIRECTORY, else ~/.local/state/basalt; calibrations
+                     are saved to the show's cave files without either)
   --no-resume        start from the beginning, not where the show was before it stopped
+  --strict           a show whose manifest or entry has errors does not start: exit 1 (for
+                     CI); without it such a show never goes dark (below)
   -h, --help         this text
 
-Exit status: 0 when the show ran, 1 when it could not start or failed, 2 for usage errors.
+Never dark: every show that starts cleanly is kept as its last good copy in the state folder
+(STATE_DIR/last-good/). When the manifest or its entry has errors, Basalt logs them (file:line)
+and plays the last good copy instead; with none it shows the problem card (an amber screen)
+while the status page says what is wrong, where, and the node's address. Either way the status
+server runs and /health says "degraded" with the errors; fix the show and reload (SIGHUP or
+POST /control/reload). A reload that fails keeps the show playing and is "degraded" too.
+
+Exit status: 0 when the show ran, 1 when it could not start or failed (with --strict also when
+the show has errors), 2 for usage errors.
 )";
 }
 
@@ -205,7 +254,8 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--clock-start", true},
                               {"--status", true},
                               {"--state-dir", true},
-                              {"--no-resume"}});
+                              {"--no-resume"},
+                              {"--strict"}});
   if (!parsed) return std::unexpected(parsed.error());
   RunOptions run;
   for (const ParsedOption& o : *parsed) {
@@ -215,7 +265,11 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                                                         (run.manifest ? *run.manifest : *run.show).string()));
       }
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
-      if (o.value.ends_with(".toml")) {
+      if (std::error_code ec; std::filesystem::is_directory(o.value, ec)) {
+        auto manifest = showFolderManifest(o.value);
+        if (!manifest) return std::unexpected(manifest.error());
+        run.manifest = std::move(*manifest);
+      } else if (o.value.ends_with(".toml")) {
         run.manifest = std::filesystem::path(o.value);
       } else {
         run.show = std::filesystem::path(o.value);  // a LAVA script; runShow says if it is not one
@@ -329,14 +383,20 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       run.stateDir = std::filesystem::path(o.value);
     } else if (o.name == "--no-resume") {
       run.resume = false;
+    } else if (o.name == "--strict") {
+      run.strict = true;
     }
   }
   for (const auto& [name, zoom] : run.zooms) {
     const bool known =
         std::any_of(run.movies.begin(), run.movies.end(), [&](const auto& m) { return m.first == name; });
     if (!known) {
+      std::vector<std::string_view> movies;
+      movies.reserve(run.movies.size());
+      for (const auto& m : run.movies) movies.emplace_back(m.first);
       return fail(Errc::kInvalidArgument,
-                  fmt::format("--zoom {}: no movie of that name; give --movie {}=FILE too", name, name));
+                  fmt::format("--zoom {}: no movie of that name{}", name,
+                              didYouMean(name, movies, fmt::format("; give --movie {}=FILE too", name))));
     }
   }
   if (run.zoomDials && run.zooms.empty()) {
@@ -379,21 +439,104 @@ render::OutputKind toRenderKind(OutputKind kind) {
 
 /// Reads and validates the manifest (the files it names must exist inside the show folder; their
 /// contents are read as the show loads them, and `basalt check` parses them all beforehand);
-/// prints its errors and warnings.
-std::optional<Manifest> readShowManifest(const std::filesystem::path& file) {
+/// prints its errors and warnings. The errors are added to `errors` ("file:line: message").
+std::optional<Manifest> readShowManifest(const std::filesystem::path& file, bool strict,
+                                         std::vector<std::string>& errors) {
   Diagnostics diagnostics;
   auto manifest = readManifest(file, diagnostics);
   for (const Diagnostic& d : diagnostics.items()) {
     if (d.severity != Severity::kNote) fmt::print(stderr, "{}\n", d.format());
+    if (d.severity == Severity::kError) errors.push_back(d.format());
   }
   if (!manifest) {
-    fmt::print(stderr,
-               "basalt: error: cannot start: {} has {} problem{} (above); 'basalt check {}' lists them without "
-               "starting\n",
-               file.string(), diagnostics.errorCount(), diagnostics.errorCount() == 1 ? "" : "s", file.string());
+    fmt::print(stderr, "basalt: error: {}{} has {} problem{} (above); 'basalt check {}' lists them without starting\n",
+               strict ? "cannot start: " : "", file.string(), diagnostics.errorCount(),
+               diagnostics.errorCount() == 1 ? "" : "s", file.string());
   }
   return manifest;
 }
+
+/// This node's addresses beside its name ("kiosk-3 (192.168.1.20, fe80::1)"), for the problem
+/// card: what a technician types to reach its status page.
+std::string nodeAddress() {
+  std::array<char, 256> name{};
+  std::string out = ::gethostname(name.data(), name.size() - 1) == 0 ? std::string(name.data()) : "this node";
+  std::vector<std::string> addresses;
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) == 0) {
+    for (const ifaddrs* a = list; a; a = a->ifa_next) {
+      if (!a->ifa_addr || (a->ifa_flags & IFF_LOOPBACK) || !(a->ifa_flags & IFF_UP)) continue;
+      std::array<char, INET6_ADDRSTRLEN> text{};
+      const int family = a->ifa_addr->sa_family;
+      const void* raw = nullptr;
+      if (family == AF_INET) raw = &reinterpret_cast<const sockaddr_in*>(a->ifa_addr)->sin_addr;
+      if (family == AF_INET6) raw = &reinterpret_cast<const sockaddr_in6*>(a->ifa_addr)->sin6_addr;
+      if (raw && ::inet_ntop(family, raw, text.data(), text.size())) addresses.emplace_back(text.data());
+    }
+    ::freeifaddrs(list);
+  }
+  return addresses.empty() ? out + " (no network address)" : fmt::format("{} ({})", out, fmt::join(addresses, ", "));
+}
+
+/// What plays when the show has errors (and --strict is not given): its last good copy, or the
+/// problem card. `problems` says what is wrong, for the log and /health.
+struct Fallback {
+  Manifest manifest;
+  std::vector<std::string> problems;
+  bool card = false;
+};
+
+Fallback fallBack(const RunOptions& options, std::vector<std::string> errors, bool tryCopy = true) {
+  const std::filesystem::path original = std::filesystem::absolute(*options.manifest);
+  const std::filesystem::path stateFolder = options.stateDir ? *options.stateDir : defaultStateFolder();
+  Fallback f;
+  for (const std::string& e : errors) log::error(kLogRun, "{}", e);
+  if (auto copy = tryCopy ? findLastGood(stateFolder, original) : std::nullopt) {
+    Diagnostics diagnostics;
+    if (auto read = readManifest(copy->manifest, diagnostics)) {
+      f.manifest = std::move(*read);
+      // Reloads re-read the show's own manifest (fixed by then), and it resumes as itself.
+      f.manifest.file = original;
+      f.manifest.status.enabled = true;  // the status page says what is wrong
+      f.problems = std::move(errors);
+      f.problems.push_back(fmt::format("{} has errors: the last good copy from {} plays ({})", original.string(),
+                                       copy->savedAt, copy->manifest.parent_path().string()));
+      log::error(kLogRun, "{} has errors; the last good copy from {} plays instead; fix the show and reload",
+                 original.string(), copy->savedAt);
+      return f;
+    }
+    log::error(kLogRun, "the last good copy {} cannot be read either", copy->manifest.string());
+  }
+  f.card = true;
+  f.manifest = Manifest::builtinDefault();
+  f.manifest.name = "problem card";
+  f.manifest.entry = {EntryKind::kBuiltinBlack, "black", {}, 0};
+  f.manifest.file = original;  // a reload re-reads the show
+  f.manifest.kiosk.resume = false;
+  f.manifest.status.enabled = true;  // the technician's way in: the default 127.0.0.1:8180 unless --status
+  f.problems = std::move(errors);
+  f.problems.push_back(fmt::format("{} has errors and there is no last good copy: the problem card shows; node {}",
+                                   original.string(), nodeAddress()));
+  log::error(kLogRun, "{}", f.problems.back());
+  return f;
+}
+
+/// The problem card: an amber screen while the show that should play has errors and no last good
+/// copy (Basalt draws no text; the status page and /health say what is wrong). It goes once a
+/// reload brings the fixed show.
+class ProblemCard final : public FrameParticipant {
+ public:
+  ProblemCard(runtime::Show& show, const ShowDirector& director) : show_(show), director_(director) {}
+  Result<void> beforeDraw(const FrameContext& /*frame*/) override {
+    if (director_.reloadsApplied() == 0) show_.global().background = kAmber;
+    return {};
+  }
+  static constexpr runtime::Color3 kAmber{1.0f, 0.6f, 0.0f};
+
+ private:
+  runtime::Show& show_;
+  const ShowDirector& director_;
+};
 
 /// "127.0.0.1:8180" or "[::1]:0" into the status spec.
 Result<void> applyStatusListen(std::string_view listen, StatusSpec& spec) {
@@ -444,12 +587,19 @@ std::string hostName() {
 }  // namespace
 
 int runShow(const RunOptions& options) {
-  registerContentReaders();
   Manifest manifest = Manifest::builtinDefault();
+  std::optional<Fallback> fallback;  // the show has errors: its last good copy or the card plays
   if (options.manifest) {
-    auto read = readShowManifest(*options.manifest);
-    if (!read) return 1;
-    manifest = std::move(*read);
+    std::vector<std::string> errors;
+    auto read = readShowManifest(*options.manifest, options.strict, errors);
+    if (read) {
+      manifest = std::move(*read);
+    } else if (options.strict) {
+      return 1;
+    } else {
+      fallback = fallBack(options, std::move(errors));
+      manifest = fallback->manifest;
+    }
   }
   if (stderrIsJournal()) logToJournal(manifest.name);
 
@@ -585,15 +735,48 @@ int runShow(const RunOptions& options) {
   }
 
   // Texture images are read in the background: the first frame does not wait for them.
-  registerShowFactories();  // hid and replay dial boxes, movie and camera streams
-  auto loaded = loadShow(manifest, clock, false);
+  ShowFactories factories = showFactories();
+  auto loaded = loadShow(manifest, clock, factories, false);
+  if (!loaded && options.manifest && !options.strict && !(fallback && fallback->card)) {
+    // The entry has errors (a script that does not parse): the last good copy plays, or the card.
+    const std::string error = loaded.error().describe();
+    fmt::print(stderr, "basalt: error: cannot load the show: {}\n", error);
+    const StatusSpec status = manifest.status;  // the manifest itself was good: its [status] holds
+    fallback = fallBack(options, {error});
+    manifest = fallback->manifest;
+    loaded = loadShow(manifest, clock, factories, false);
+    if (!loaded) {
+      fallback =
+          fallBack(options, {error, "its last good copy cannot load either: " + loaded.error().describe()}, false);
+      manifest = fallback->manifest;
+      loaded = loadShow(manifest, clock, factories, false);
+    }
+    manifest.status = status;
+    manifest.status.enabled = true;
+  }
   if (!loaded) return failWith(loaded.error(), "cannot load the show");
+  if (fallback) board.setProblems(fallback->problems);
 
   runtime::Show show;
   FrameLoop frameLoop({fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output, **renderer);
   ShowDirector director(
-      DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps});
+      DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps},
+      std::move(factories));
   director.install(std::move(*loaded), clock.now(), resume);
+  // The show started cleanly: keep it as the last good copy, in the background (the first
+  // frame does not wait for the copy).
+  std::jthread keeper;
+  if (options.manifest && !fallback) {
+    keeper = std::jthread([stateFolder = options.stateDir ? *options.stateDir : defaultStateFolder(),
+                           file = manifest.file, folder = manifest.folder] {
+      auto kept = keepLastGood(stateFolder, file, folder);
+      if (!kept) {
+        log::warn(kLogRun, "cannot keep the last good copy of the show: {}", kept.error().describe());
+      } else if (*kept == KeptCopy::kWritten) {
+        log::info(kLogRun, "kept the show as its last good copy in {}", lastGoodFolder(stateFolder, file).string());
+      }
+    });
+  }
   // Keyboards and mice where no window delivers them (KMS): read from evdev on a thread of their
   // own, taken by the director each frame the way a window's keys are.
   std::unique_ptr<devices::EvdevInput> keyboardsAndMice;
@@ -638,22 +821,53 @@ int runShow(const RunOptions& options) {
   // [[views]]: facets of an immersive display, stereo eyes, tiles (one plain view without).
   std::unique_ptr<DisplayViews> views;
   if (!manifest.views.empty()) {
-    auto made = DisplayViews::create(manifest.views, **renderer, (*output)->size());
+    // Calibrations are saved in the state folder when there is one to write (a service's
+    // StateDirectory=, or --state-dir): the show's folder may be read-only. Otherwise, by hand,
+    // they go back to the show's cave files.
+    std::filesystem::path calibrations;
+    if (options.stateDir) {
+      calibrations = *options.stateDir / "calibration";
+    } else if (const char* dir = std::getenv("STATE_DIRECTORY"); dir && *dir) {
+      calibrations = defaultStateFolder() / "calibration";
+    }
+    auto made = DisplayViews::create(manifest.views, **renderer, (*output)->size(), calibrations);
     if (!made) return failWith(made.error(), "cannot set up the show's views");
     views = std::move(*made);
     frameLoop.setViewDrawer(views.get());
     director.setViews(views.get());
   }
 
+  // Devices beside the show's: a replayed trace (--replay) pushes into the run's one queue,
+  // numbered apart from the show's devices, and the director applies its events with theirs,
+  // through LAVA's dial table (and the Zoom dials, below). Its stepper comes before the director,
+  // so that under a ManualClock what it has due by a frame is applied in that frame.
+  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  std::optional<ReplayReport> replayed;  // what the replay played, said once at the end (outlives `devices`)
+  std::unique_ptr<DeviceWiring> devices;
+  if (options.replay) {
+    devices = std::make_unique<DeviceWiring>(clock, events, kReplayFirstId);
+    auto ids = devices->addReplay(*options.replay, !options.replayOnce, matroskaTraceReaderFactory());
+    if (!ids) return failWith(ids.error(), "cannot replay");
+    devices->manager().setTaps(&replayed.emplace(*options.replay, clock), &*replayed);
+    director.setReplayInput(&bindings, std::move(*ids));
+    frameLoop.addParticipant(devices->participant());
+    devices->start(manual);
+  }
+
   FrameMetrics metrics(board, &events, (*output)->describe());
   frameLoop.addParticipant(metrics);
   frameLoop.addParticipant(director);
+  std::optional<ProblemCard> card;
+  if (fallback && fallback->card) {
+    card.emplace(show, director);
+    frameLoop.addParticipant(*card);
+  }
   frameLoop.addParticipant(*supervisor);
 
   std::optional<ScriptPlayer> player;
   if (script) {
     ScriptPlayerOptions playerOptions;
-    setScriptVcrOptions(playerOptions, manifest, clock);
+    setScriptVcrOptions(playerOptions, manifest, clock, director.devices());
     playerOptions.outputDir = options.outputDir;
     if (options.saveImage) playerOptions.saveImage = *options.saveImage;
     player.emplace(std::move(*script), show, **renderer, std::move(playerOptions));
@@ -699,8 +913,6 @@ int runShow(const RunOptions& options) {
     recorder = std::move(*r);
     frameLoop.addParticipant(*recorder);
   }
-  // Devices: a replayed trace drives the show through LAVA's dial table.
-  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
   if (options.zoomDials && videos) {
     // A full turn moves the Zoom picture across the whole output (LAVA: Shift + drag).
     const render::Size size = (*output)->size();
@@ -709,16 +921,6 @@ int runShow(const RunOptions& options) {
     bindings.setDial(static_cast<std::size_t>(options.zoomDials->second),
                      {runtime::Action::kMoveZoomY, static_cast<double>(size.height)});
     videos->followZoomDials(&bindings);
-  }
-  std::unique_ptr<DeviceWiring> devices;
-  if (options.replay) {
-    devices = std::make_unique<DeviceWiring>(clock, [eventLoop] { eventLoop->wake(); });
-    if (auto r = devices->addReplay(*options.replay, !options.replayOnce, matroskaTraceReaderFactory()); !r) {
-      return failWith(r.error(), "cannot replay");
-    }
-    frameLoop.addParticipant(devices->participant());
-    frameLoop.setEvents(&devices->events(), &bindings);
-    devices->start(manual);
   }
 
   // [lock]: the frame lock is the last participant, so that the leader sends the frame's final
@@ -795,6 +997,7 @@ int runShow(const RunOptions& options) {
   std::vector<devices::DeviceStatus> deviceStatus;
   if (devices) {
     deviceStatus = devices->manager().status();
+    devices->manager().setTaps(nullptr, nullptr);
     devices->stop();
   }
   supervisor->stopping();
@@ -844,12 +1047,7 @@ int runShow(const RunOptions& options) {
                  recorder->describe());
     }
   }
-  if (devices) {
-    for (const devices::DeviceStatus& s : deviceStatus) {
-      fmt::print("basalt: replayed {} '{}' ({})\n", devices::deviceKindName(s.kind), s.name,
-                 s.lastError.empty() ? std::string(devices::deviceStateName(s.state)) : s.lastError);
-    }
-  }
+  if (replayed) fmt::print("basalt: {}\n", replayed->summary(deviceStatus));
   std::fflush(stdout);
   return status;
 }

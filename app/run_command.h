@@ -30,6 +30,7 @@ struct RunOptions {
   bool fpsGiven = false;                          ///< --fps was given (else the manifest's)
   std::optional<std::filesystem::path> stateDir;  ///< where the resume point is kept
   bool resume = true;                             ///< --no-resume starts from the beginning
+  bool strict = false;                            ///< --strict: a show with errors does not start (CI)
   std::optional<WallTime> clockStart;             ///< the manual clock's calendar start (schedules)
   std::optional<std::string> statusListen;        ///< --status ADDRESS:PORT
   std::optional<std::int64_t> frames;             ///< stop after this many frames

@@ -81,9 +81,18 @@ FrameRef ManagedVideoStream::frameAt(Nanos showTime) {
   std::shared_ptr<VideoSource> source;
   {
     std::lock_guard lock(mutex_);
+    if (!source_) return {};
+    // Another reader (a second texture of the same camera) asked for this frame already.
+    if (showTime == lastAt_) return last_;
     source = source_;
   }
-  return source ? source->frameAt(showTime) : FrameRef{};
+  FrameRef frame = source->frameAt(showTime);
+  std::lock_guard lock(mutex_);
+  if (source_ == source) {
+    last_ = frame;
+    lastAt_ = showTime;
+  }
+  return frame;
 }
 
 SourceHealth ManagedVideoStream::health() const {
@@ -105,24 +114,55 @@ bool ManagedVideoStream::mirrorInRenderer() const {
 void ManagedVideoStream::attach(std::shared_ptr<VideoSource> source) {
   std::lock_guard lock(mutex_);
   source_ = std::move(source);
+  last_.reset();
+  lastAt_ = Nanos{-1};
 }
 
 void ManagedVideoStream::detach(SourceState state, Nanos since) {
   std::shared_ptr<VideoSource> old;
+  FrameRef frame;
   {
     std::lock_guard lock(mutex_);
     old = std::move(source_);
+    frame = std::move(last_);
+    lastAt_ = Nanos{-1};
     idle_ = {state, since};
   }
 }
 
 // DeviceManager
 
+/// Every frame of one video request goes to the recorder's tap (if any) and to the taps its
+/// users added (a camera's MJPEG decoder). Called on the producer's thread.
+class DeviceManager::FrameFanOut final : public FrameTap {
+ public:
+  explicit FrameFanOut(const std::atomic<FrameTap*>& recorder) : recorder_(recorder) {}
+
+  void onFrame(DeviceId device, const FrameRef& frame) override {
+    if (FrameTap* recorder = recorder_.load(std::memory_order_acquire)) recorder->onFrame(device, frame);
+    std::lock_guard lock(mutex_);
+    for (const auto& tap : taps_) tap->onFrame(device, frame);
+  }
+  void add(std::shared_ptr<FrameTap> tap) {
+    std::lock_guard lock(mutex_);
+    taps_.push_back(std::move(tap));
+  }
+  void remove(const FrameTap* tap) {
+    std::lock_guard lock(mutex_);
+    std::erase_if(taps_, [tap](const auto& t) { return t.get() == tap; });
+  }
+
+ private:
+  const std::atomic<FrameTap*>& recorder_;
+  std::mutex mutex_;                             // guards taps_
+  std::vector<std::shared_ptr<FrameTap>> taps_;  // guarded by mutex_
+};
+
 DeviceManager::DeviceManager(const Clock& clock, BoundedQueue<Event>& events)
     : DeviceManager(clock, events, Config{}) {}
 
 DeviceManager::DeviceManager(const Clock& clock, BoundedQueue<Event>& events, Config config)
-    : clock_(clock), events_(events), config_(config) {}
+    : clock_(clock), events_(events), config_(config), nextId_(config.firstId) {}
 
 DeviceManager::~DeviceManager() { stop(); }
 
@@ -131,27 +171,78 @@ void DeviceManager::addProvider(std::unique_ptr<DeviceProvider> provider) {
   providers_.push_back(std::move(provider));
 }
 
-Result<DeviceId> DeviceManager::request(DeviceRequest request) {
-  for (const auto& s : slots_) {
-    if (s->request.name == request.name) {
-      return fail(Errc::kInvalidArgument,
-                  fmt::format("two devices are named '{}'; give each device of the show its own name", request.name));
-    }
-  }
+Result<DeviceId> DeviceManager::request(DeviceRequest request, std::unique_ptr<DeviceProvider> provider,
+                                        Upkeep upkeep) {
   auto slot = std::make_unique<Slot>();
-  slot->id = nextId_++;
   slot->since = clock_.now();
+  slot->frames = std::make_shared<FrameFanOut>(frameTap_);
   if (request.kind == DeviceKind::kVideoSource) {
     slot->stream = std::make_shared<ManagedVideoStream>();
     slot->stream->detach(SourceState::kWaiting, slot->since);
-    std::lock_guard lock(mutex_);
-    streams_[request.name] = slot->stream;
   }
+  if (provider) provider->watchHotplug([this](HotplugEvent e) { notifyHotplug(std::move(e)); });
+  slot->provider = std::move(provider);
   slot->request = std::move(request);
-  const DeviceId id = slot->id;
-  slots_.push_back(std::move(slot));
-  publish();
+  slot->upkeep = upkeep;
+  DeviceId id = 0;
+  {
+    std::lock_guard lock(mutex_);
+    const std::string& name = slot->request.name;
+    if (held_.contains(name)) {
+      return fail(Errc::kInvalidArgument,
+                  fmt::format("two devices are named '{}'; give each device of the show its own name", name));
+    }
+    id = nextId_++;
+    slot->id = id;
+    held_.emplace(name, Held{id, 1, slot->frames});
+    if (slot->stream) streams_[name] = slot->stream;
+    status_.push_back(statusOf(*slot));
+    incoming_.push_back(std::move(slot));
+  }
+  statusVersion_.fetch_add(1, std::memory_order_acq_rel);
+  wake_.notify_all();
   return id;
+}
+
+Result<DeviceId> DeviceManager::share(std::string_view name) {
+  std::lock_guard lock(mutex_);
+  const auto it = held_.find(name);
+  if (it == held_.end()) return fail(Errc::kNotFound, fmt::format("no device '{}' is requested", name));
+  ++it->second.users;
+  return it->second.id;
+}
+
+void DeviceManager::withdraw(std::string_view name) {
+  std::unique_ptr<Slot> unopened;  // destroyed after the lock: its provider may do I/O
+  {
+    std::lock_guard lock(mutex_);
+    const auto it = held_.find(name);
+    if (it == held_.end() || --it->second.users > 0) return;
+    const DeviceId id = it->second.id;
+    held_.erase(it);
+    if (const auto s = streams_.find(name); s != streams_.end()) streams_.erase(s);
+    std::erase_if(status_, [id](const DeviceStatus& st) { return st.id == id; });
+    const auto waiting = std::find_if(incoming_.begin(), incoming_.end(), [id](const auto& s) { return s->id == id; });
+    if (waiting != incoming_.end()) {
+      unopened = std::move(*waiting);
+      incoming_.erase(waiting);
+    } else {
+      withdrawn_.push_back(id);
+    }
+  }
+  statusVersion_.fetch_add(1, std::memory_order_acq_rel);
+  wake_.notify_all();
+}
+
+bool DeviceManager::restart(std::string_view name) {
+  {
+    std::lock_guard lock(mutex_);
+    const auto it = held_.find(name);
+    if (it == held_.end()) return false;
+    restarts_.push_back(it->second.id);
+  }
+  wake_.notify_all();
+  return true;
 }
 
 void DeviceManager::notifyHotplug(HotplugEvent event) {
@@ -164,15 +255,29 @@ void DeviceManager::notifyHotplug(HotplugEvent event) {
 }
 
 void DeviceManager::setTaps(ReportTap* reports, FrameTap* frames) {
-  std::lock_guard lock(mutex_);
-  reportTap_ = reports;
-  frameTap_ = frames;
-  tapsChanged_ = true;
+  {
+    std::lock_guard lock(mutex_);
+    reportTap_ = reports;
+    tapsChanged_ = true;
+  }
+  frameTap_.store(frames, std::memory_order_release);
 }
 
-bool DeviceManager::pathInUse(const Slot& except, const std::string& path) const {
+void DeviceManager::addFrameTap(std::string_view name, std::shared_ptr<FrameTap> tap) {
+  std::lock_guard lock(mutex_);
+  if (const auto it = held_.find(name); it != held_.end()) it->second.frames->add(std::move(tap));
+}
+
+void DeviceManager::removeFrameTap(std::string_view name, const FrameTap* tap) {
+  std::lock_guard lock(mutex_);
+  if (const auto it = held_.find(name); it != held_.end()) it->second.frames->remove(tap);
+}
+
+bool DeviceManager::pathInUse(const Slot& except, const DeviceProvider* provider, const std::string& path) const {
+  // Only devices found through the same backend object can be the same device: a request with a
+  // backend of its own (a synthetic script, a replayed file) has its devices to itself.
   return std::any_of(slots_.begin(), slots_.end(), [&](const auto& s) {
-    return s.get() != &except && (s->state == DeviceState::kLive) && s->device.path == path;
+    return s.get() != &except && s->state == DeviceState::kLive && s->foundBy == provider && s->device.path == path;
   });
 }
 
@@ -191,108 +296,164 @@ void DeviceManager::tryOpen(Slot& slot, Nanos now) {
   transition(slot, wasLost ? DeviceState::kReopening : DeviceState::kOpening, now);
   publish();
   ReportTap* reportTap = nullptr;
-  FrameTap* frameTap = nullptr;
   {
     std::lock_guard lock(mutex_);
     reportTap = reportTap_;
-    frameTap = frameTap_;
   }
-  std::string error;
+  std::string reasons;  // why the devices that match cannot be used
   bool matched = false;
-  for (const auto& provider : providers_) {
-    if (!slot.request.match.backend.empty() && provider->backend() != slot.request.match.backend) continue;
-    for (const DeviceCandidate& c : provider->enumerate()) {
-      if (c.kind != slot.request.kind || !slot.request.match.matches(c.info) || pathInUse(slot, c.info.path)) continue;
-      matched = true;
-      if (slot.request.kind == DeviceKind::kDialBox) {
-        auto dial = provider->openDialBox(c, slot.request, clock_);
-        if (dial) {
-          (*dial)->setReportTap(reportTap);
-          if (auto r = (*dial)->open(slot.id, events_); r) {
-            slot.dial = std::move(*dial);
-            slot.device = slot.dial->info();
-          } else {
-            error = r.error().describe();
-          }
-        } else {
-          error = dial.error().describe();
-        }
-      } else {
-        auto video = provider->openVideoSource(c, slot.request, clock_);
-        if (video) {
-          (*video)->setFrameTap(frameTap);
-          auto r = (*video)->setControls(slot.request.controls);
-          if (r) r = (*video)->open(slot.id);
-          if (r) {
-            slot.video = std::move(*video);
-            slot.device = slot.video->info();
-            slot.stream->attach(slot.video);
-          } else {
-            error = r.error().describe();
-          }
-        } else {
-          error = video.error().describe();
-        }
+  const auto tryProvider = [&](DeviceProvider& provider) {
+    for (const DeviceCandidate& c : provider.enumerate()) {
+      if (c.kind != slot.request.kind || !slot.request.match.matches(c.info) ||
+          pathInUse(slot, &provider, c.info.path)) {
+        continue;
       }
-      if (slot.dial || slot.video) break;
+      matched = true;
+      if (!c.problem.empty()) {
+        // Known in advance (not a dial, no permission): not worth an open.
+        reasons += fmt::format("; {}: {}", describeDevice(c.info), c.problem);
+        continue;
+      }
+      if (slot.request.kind == DeviceKind::kDialBox) {
+        auto dial = provider.openDialBox(c, slot.request, clock_);
+        if (!dial) {
+          reasons += "; " + dial.error().describe();
+          continue;
+        }
+        (*dial)->setReportTap(reportTap);
+        if (auto r = (*dial)->open(slot.id, events_); !r) {
+          reasons += "; " + r.error().describe();
+          continue;
+        }
+        slot.dial = std::move(*dial);
+        slot.device = slot.dial->info();
+      } else {
+        auto video = provider.openVideoSource(c, slot.request, clock_);
+        if (!video) {
+          reasons += "; " + video.error().describe();
+          continue;
+        }
+        (*video)->setFrameTap(slot.frames.get());
+        auto r = (*video)->setControls(slot.request.controls);
+        if (r) r = (*video)->open(slot.id);
+        if (!r) {
+          reasons += "; " + r.error().describe();
+          continue;
+        }
+        slot.video = std::move(*video);
+        slot.device = slot.video->info();
+        slot.stream->attach(slot.video);
+      }
+      slot.foundBy = &provider;
+      return true;
     }
-    if (slot.dial || slot.video) break;
+    return false;
+  };
+  if (slot.provider) {
+    (void)tryProvider(*slot.provider);
+  } else {
+    for (const auto& provider : providers_) {
+      if (!slot.request.match.backend.empty() && provider->backend() != slot.request.match.backend) continue;
+      if (tryProvider(*provider)) break;
+    }
   }
   if (slot.dial || slot.video) {
-    log::info(kLogDevices, "{} '{}': {} is live{}", deviceKindName(slot.request.kind), slot.request.name,
-              describeDevice(slot.device), wasLost ? " again" : "");
+    if (!slot.upkeep.quiet) {
+      log::info(kLogDevices, "{} '{}': {} is live{}", deviceKindName(slot.request.kind), slot.request.name,
+                describeDevice(slot.device), wasLost ? " again" : "");
+    }
     slot.attempts = 0;
     slot.backoff = Nanos{0};
     slot.lastError.clear();
     transition(slot, DeviceState::kLive, now);
     return;
   }
-  if (!matched) {
-    error = fmt::format("no device matches {}; is it plugged in? ('basalt devices' lists what is connected)",
-                        slot.request.match.describe());
-  }
-  if (slot.attempts == 0 || error != slot.lastError) {
+  const std::string rule = slot.request.match.backend.empty()
+                               ? fmt::format("device ({})", slot.request.match.describe())
+                               : slot.request.match.describe();
+  std::string error =
+      matched
+          ? fmt::format("{} found but not usable{}", rule, reasons)
+          : fmt::format("no {} is plugged in: no device matches it ('basalt devices' lists what is connected)", rule);
+  if (!slot.upkeep.quiet && (slot.attempts == 0 || error != slot.lastError)) {
     log::warn(kLogDevices, "{} '{}' is not available: {}; trying again", deviceKindName(slot.request.kind),
               slot.request.name, error);
   }
   slot.lastError = std::move(error);
   ++slot.attempts;
-  slot.backoff = slot.backoff.count() == 0 ? config_.firstBackoff : std::min(slot.backoff * 2, config_.maxBackoff);
+  const Backoff backoff = slot.upkeep.backoff.value_or(Backoff{config_.firstBackoff, config_.maxBackoff});
+  slot.backoff = slot.backoff.count() == 0 ? backoff.first : std::min(slot.backoff * 2, backoff.max);
   slot.nextAttempt = now + slot.backoff;
   transition(slot, wasLost ? DeviceState::kLost : DeviceState::kAbsent, now);
 }
 
-void DeviceManager::markLost(Slot& slot, Nanos now, std::string why) {
-  log::warn(kLogDevices, "{} '{}' lost: {}: {}; reconnecting by itself", deviceKindName(slot.request.kind),
-            slot.request.name, describeDevice(slot.device), why);
+void DeviceManager::closeDevice(Slot& slot, SourceState streamState, Nanos now) {
   if (slot.dial) {
     slot.dial->close();
     slot.dial.reset();
   }
   if (slot.video) {
-    slot.stream->detach(SourceState::kLost, now);
+    slot.stream->detach(streamState, now);
     slot.video->close();
     slot.video.reset();
   }
+  slot.foundBy = nullptr;
+}
+
+void DeviceManager::markLost(Slot& slot, Nanos now, std::string why) {
+  if (!slot.upkeep.quiet) {
+    log::warn(kLogDevices, "{} '{}' lost: {}: {}; reconnecting by itself", deviceKindName(slot.request.kind),
+              slot.request.name, describeDevice(slot.device), why);
+  }
+  closeDevice(slot, SourceState::kLost, now);
   slot.lastError = std::move(why);
-  slot.backoff = config_.firstBackoff;
-  slot.nextAttempt = now + config_.firstBackoff;
+  const Backoff backoff = slot.upkeep.backoff.value_or(Backoff{config_.firstBackoff, config_.maxBackoff});
+  slot.backoff = backoff.first;
+  slot.nextAttempt = now + backoff.first;
   transition(slot, DeviceState::kLost, now);
+}
+
+DeviceManager::Slot* DeviceManager::slotNamed(std::string_view name) const {
+  DeviceId id = 0;
+  {
+    std::lock_guard lock(mutex_);
+    const auto it = held_.find(name);
+    if (it == held_.end()) return nullptr;
+    id = it->second.id;
+  }
+  for (const auto& s : slots_) {
+    if (s->id == id) return s.get();
+  }
+  return nullptr;
 }
 
 void DeviceManager::step(Nanos now) {
   std::vector<HotplugEvent> hotplug;
+  std::vector<std::unique_ptr<Slot>> incoming;
+  std::vector<DeviceId> withdrawn;
+  std::vector<DeviceId> restarts;
   bool tapsChanged = false;
   ReportTap* reportTap = nullptr;
-  FrameTap* frameTap = nullptr;
   {
     std::lock_guard lock(mutex_);
     if (!hotplug_.empty()) hotplug.swap(hotplug_);
+    if (!incoming_.empty()) incoming.swap(incoming_);
+    if (!withdrawn_.empty()) withdrawn.swap(withdrawn_);
+    if (!restarts_.empty()) restarts.swap(restarts_);
     tapsChanged = std::exchange(tapsChanged_, false);
     reportTap = reportTap_;
-    frameTap = frameTap_;
   }
   bool changed = false;
+  // Withdrawn first: a request made again under the same name may want the same device.
+  for (const DeviceId id : withdrawn) {
+    const auto it = std::find_if(slots_.begin(), slots_.end(), [id](const auto& s) { return s->id == id; });
+    if (it == slots_.end()) continue;
+    closeDevice(**it, SourceState::kWaiting, now);
+    slots_.erase(it);
+    changed = true;
+  }
+  for (auto& s : incoming) slots_.push_back(std::move(s));
+  changed = changed || !incoming.empty();
   for (const HotplugEvent& h : hotplug) {
     for (auto& s : slots_) {
       if (h.action == HotplugEvent::Action::kRemoved) {
@@ -301,20 +462,35 @@ void DeviceManager::step(Nanos now) {
           changed = true;
         }
       } else if (s->state == DeviceState::kAbsent || s->state == DeviceState::kLost) {
-        s->nextAttempt = now;  // something appeared: look at once instead of waiting out the back-off
+        // Something appeared: look at once instead of waiting out the back-off, and start the
+        // back-off over.
+        s->nextAttempt = now;
+        s->backoff = Nanos{0};
       }
     }
+  }
+  for (const DeviceId id : restarts) {
+    const auto it = std::find_if(slots_.begin(), slots_.end(), [id](const auto& s) { return s->id == id; });
+    if (it == slots_.end()) continue;
+    Slot& s = **it;
+    if (s.state == DeviceState::kLive) {
+      // Its bindings let go, as for any loss; the open below may bring it back at once.
+      closeDevice(s, SourceState::kLost, now);
+      transition(s, DeviceState::kLost, now);
+    }
+    s.backoff = Nanos{0};
+    tryOpen(s, now);
+    ++s.restarts;
+    changed = true;
   }
   for (auto& sp : slots_) {
     Slot& s = *sp;
     if (s.state == DeviceState::kLive) {
-      if (tapsChanged) {
-        if (s.dial) s.dial->setReportTap(reportTap);
-        if (s.video) s.video->setFrameTap(frameTap);
-      }
+      if (tapsChanged && s.dial) s.dial->setReportTap(reportTap);
       if (s.dial) {
         s.dial->service(now);
-        if (s.dial->state() == DeviceState::kLost) {
+        if (s.dial->state() != DeviceState::kLive) {
+          // Lost (a read error, an unplug), or closed under the manager's feet: either way gone.
           const auto why = s.dial->lostReason();
           markLost(s, now, why ? why->describe() : "the device stopped answering");
           changed = true;
@@ -339,34 +515,44 @@ void DeviceManager::step(Nanos now) {
   if (changed) publish();
 }
 
+DeviceStatus DeviceManager::statusOf(const Slot& s) const {
+  DeviceStatus st;
+  st.name = s.request.name;
+  st.kind = s.request.kind;
+  st.state = s.state;
+  st.since = s.since;
+  st.id = s.id;
+  st.device = s.device;
+  st.match = s.request.match.describe();
+  st.lastError = s.lastError;
+  st.attempts = s.attempts;
+  st.nextAttempt = s.nextAttempt;
+  st.restarts = s.restarts;
+  if (s.dial && s.state == DeviceState::kLive) st.reportDescriptor = s.dial->reportDescriptor();
+  if (s.video && s.state == DeviceState::kLive) st.mode = s.video->mode();
+  if (s.video && s.state == DeviceState::kLive && s.video->state() != DeviceState::kLive) {
+    // The device itself is lost but recovering (an HDMI signal gone): show its state.
+    st.state = s.video->state();
+    st.since = s.video->stateSince();
+    if (auto why = s.video->lostReason()) st.lastError = why->describe();
+  }
+  return st;
+}
+
 void DeviceManager::publish() {
   std::vector<DeviceStatus> out;
   out.reserve(slots_.size());
-  for (const auto& sp : slots_) {
-    const Slot& s = *sp;
-    DeviceStatus st;
-    st.name = s.request.name;
-    st.kind = s.request.kind;
-    st.state = s.state;
-    st.since = s.since;
-    st.id = s.id;
-    st.device = s.device;
-    st.match = s.request.match.describe();
-    st.lastError = s.lastError;
-    st.attempts = s.attempts;
-    st.nextAttempt = s.nextAttempt;
-    if (s.dial && s.state == DeviceState::kLive) st.reportDescriptor = s.dial->reportDescriptor();
-    if (s.video && s.state == DeviceState::kLive) st.mode = s.video->mode();
-    if (s.video && s.state == DeviceState::kLive && s.video->state() != DeviceState::kLive) {
-      // The device itself is lost but recovering (an HDMI signal gone): show its state.
-      st.state = s.video->state();
-      st.since = s.video->stateSince();
-      if (auto why = s.video->lostReason()) st.lastError = why->describe();
-    }
-    out.push_back(std::move(st));
+  for (const auto& sp : slots_) out.push_back(statusOf(*sp));
+  {
+    std::lock_guard lock(mutex_);
+    // Requests withdrawn or made since this step began show as they are now.
+    std::erase_if(out, [this](const DeviceStatus& st) {
+      return std::find(withdrawn_.begin(), withdrawn_.end(), st.id) != withdrawn_.end();
+    });
+    for (const auto& s : incoming_) out.push_back(statusOf(*s));
+    status_ = std::move(out);
   }
-  std::lock_guard lock(mutex_);
-  status_ = std::move(out);
+  statusVersion_.fetch_add(1, std::memory_order_acq_rel);
 }
 
 std::vector<DeviceStatus> DeviceManager::status() const {
@@ -381,17 +567,13 @@ std::shared_ptr<ManagedVideoStream> DeviceManager::videoStream(std::string_view 
 }
 
 DialBox* DeviceManager::dialBox(std::string_view name) const {
-  for (const auto& s : slots_) {
-    if (s->request.name == name) return s->dial.get();
-  }
-  return nullptr;
+  const Slot* s = slotNamed(name);
+  return s ? s->dial.get() : nullptr;
 }
 
 std::shared_ptr<VideoSource> DeviceManager::videoSource(std::string_view name) const {
-  for (const auto& s : slots_) {
-    if (s->request.name == name) return s->video;
-  }
-  return nullptr;
+  const Slot* s = slotNamed(name);
+  return s ? s->video : nullptr;
 }
 
 void DeviceManager::start(Nanos period) {
@@ -404,7 +586,9 @@ void DeviceManager::start(Nanos period) {
     for (;;) {
       step(clock_.now());
       std::unique_lock lock(mutex_);
-      wake_.wait_for(lock, period, [this] { return stopping_ || !hotplug_.empty(); });
+      wake_.wait_for(lock, period, [this] {
+        return stopping_ || !hotplug_.empty() || !incoming_.empty() || !withdrawn_.empty() || !restarts_.empty();
+      });
       if (stopping_) break;
     }
   });
@@ -423,13 +607,7 @@ void DeviceManager::stop() {
 void DeviceManager::closeAll() {
   const Nanos now = clock_.now();
   for (auto& s : slots_) {
-    if (s->dial) s->dial->close();
-    if (s->video) {
-      s->stream->detach(SourceState::kWaiting, now);
-      s->video->close();
-    }
-    s->dial.reset();
-    s->video.reset();
+    closeDevice(*s, SourceState::kWaiting, now);
     if (s->state != DeviceState::kAbsent) {
       s->state = DeviceState::kAbsent;
       s->since = now;

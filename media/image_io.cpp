@@ -44,6 +44,11 @@ std::string lowerExtension(const std::filesystem::path& path) {
   return ext;
 }
 
+/// Where the OIIO module is looked for, in order: BASALT_MODULE_DIR; beside the executable (the
+/// build folder's `basalt`); the install folder relative to the executable (an installed tree
+/// also works when staged under another root, DESTDIR or a package's); the install folder as
+/// configured; the build folder, for programs that run from inside it (the tests) only. An
+/// installed or copied `basalt` never loads a build folder's module, which may be stale or gone.
 std::vector<std::filesystem::path> moduleSearchPath() {
   std::vector<std::filesystem::path> dirs;
   if (const char* env = std::getenv("BASALT_MODULE_DIR"); env && *env) dirs.emplace_back(env);
@@ -51,9 +56,16 @@ std::vector<std::filesystem::path> moduleSearchPath() {
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (!ec) {
     dirs.push_back(exe.parent_path());
-    dirs.push_back(exe.parent_path() / ".." / "lib" / "basalt");
+    dirs.push_back((exe.parent_path() / BASALT_MODULE_RELATIVE_DIR).lexically_normal());
   }
-  dirs.emplace_back(BASALT_MODULE_BUILD_DIR);
+  dirs.emplace_back(BASALT_MODULE_INSTALL_DIR);
+  if (!ec) {
+    // /proc/self/exe has its links resolved: compare with the build folder's resolved path.
+    const std::filesystem::path build = std::filesystem::weakly_canonical(BASALT_MODULE_BUILD_DIR, ec);
+    if (!ec && std::mismatch(build.begin(), build.end(), exe.begin(), exe.end()).first == build.end()) {
+      dirs.push_back(build);
+    }
+  }
   return dirs;
 }
 
@@ -95,8 +107,8 @@ Result<const BasaltOiioApi*> oiio() {
       return;
     }
     m.error = fmt::format(
-        "the OpenImageIO module {} is not installed (looked for{}); rebuild Basalt or set "
-        "BASALT_MODULE_DIR",
+        "the OpenImageIO module {} is not installed (looked for{}); install Basalt with its module "
+        "(cmake --install, or the package) or set BASALT_MODULE_DIR",
         kModuleName, tried);
   });
   if (!m.api) return fail(Errc::kUnavailable, m.error);

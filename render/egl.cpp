@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <mutex>
+#include <utility>
 
 #include "render/gl.h"
 
@@ -124,41 +125,71 @@ EglContext::EglContext(std::shared_ptr<EglDisplay> display, EGLContext context)
     : display_(std::move(display)), context_(context) {}
 
 EglContext::~EglContext() {
+  deleteKeptPrograms();
   if (tCurrent == this) tCurrent = nullptr;
   if (eglGetCurrentContext() == context_) {
-    // The kept programs go with the context; deleting them first keeps leak checkers quiet.
-    for (const auto& [key, id] : programs_) glDeleteProgram(id);
     eglMakeCurrent(display_->handle(), EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   }
   eglDestroyContext(display_->handle(), context_);
+}
+
+void EglContext::deleteKeptPrograms() {
+  if (programs_.empty()) return;
+  if (eglGetCurrentContext() == context_) {
+    programs_.clear();
+    return;
+  }
+  // Another context (or none) is current on this thread: this one is made current without a
+  // surface to delete its own programs (in a share group they would outlive it otherwise), and
+  // the thread gets back what it had.
+  const EGLDisplay display = display_->handle();
+  const EGLDisplay previousDisplay = eglGetCurrentDisplay();
+  const EGLContext previous = eglGetCurrentContext();
+  const EGLSurface previousDraw = eglGetCurrentSurface(EGL_DRAW);
+  const EGLSurface previousRead = eglGetCurrentSurface(EGL_READ);
+  if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
+    // No surfaceless contexts here, or the context is current on another thread: the names go
+    // when EGL destroys the context and its objects.
+    for (auto& [key, program] : programs_) (void)program.release();
+    programs_.clear();
+    return;
+  }
+  programs_.clear();
+  if (previous != EGL_NO_CONTEXT) {
+    eglMakeCurrent(previousDisplay, previousDraw, previousRead, previous);
+  } else {
+    eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  }
 }
 
 EglContext* EglContext::current() {
   return tCurrent && eglGetCurrentContext() == tCurrent->context_ ? tCurrent : nullptr;
 }
 
-std::uint32_t EglContext::keptProgram(std::string_view key) const {
+GLuint EglContext::keptProgram(std::string_view key) const {
   const auto it = programs_.find(key);
-  return it == programs_.end() ? 0 : it->second;
+  return it == programs_.end() ? 0 : it->second.id();
 }
 
-void EglContext::keepProgram(std::string key, std::uint32_t id) {
+GLuint EglContext::keepProgram(std::string key, gl::Program program) {
+  const GLuint id = program.id();
   if (const auto it = programs_.find(key); it != programs_.end()) {
-    glDeleteProgram(it->second);
-    it->second = id;
-    return;
+    it->second = std::move(program);  // deletes the one kept before
+  } else {
+    programs_.emplace(std::move(key), std::move(program));
   }
-  programs_.emplace(std::move(key), id);
+  return id;
 }
 
-Result<std::unique_ptr<EglContext>> EglContext::create(std::shared_ptr<EglDisplay> display, EGLConfig config) {
+Result<std::unique_ptr<EglContext>> EglContext::create(std::shared_ptr<EglDisplay> display, EGLConfig config,
+                                                       const EglContext* shareWith) {
   if (!eglBindAPI(EGL_OPENGL_ES_API)) {
     return fail(Errc::kUnavailable, "this EGL cannot bind the OpenGL ES API");
   }
   EGLContext context = EGL_NO_CONTEXT;
   for (EGLint minor : {2, 1, 0}) {
     const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, minor, EGL_NONE};
-    context = eglCreateContext(display->handle(), config, EGL_NO_CONTEXT, attributes);
+    context = eglCreateContext(display->handle(), config, shareWith ? shareWith->context_ : EGL_NO_CONTEXT, attributes);
     if (context != EGL_NO_CONTEXT) break;
   }
   if (context == EGL_NO_CONTEXT) {
@@ -174,6 +205,63 @@ Result<void> EglContext::makeCurrent(EGLSurface surface) {
   }
   tCurrent = this;
   return {};
+}
+
+Result<EglSurface> EglSurface::createWindow(std::shared_ptr<EglDisplay> display, EGLConfig config, void* nativeWindow,
+                                            std::string_view what) {
+  // The display was opened with eglGetPlatformDisplayEXT (EGL_EXT_platform_base): its windows
+  // are made with the matching platform call.
+  static const auto createPlatformWindowSurface = reinterpret_cast<PFNEGLCREATEPLATFORMWINDOWSURFACEEXTPROC>(
+      eglGetProcAddress("eglCreatePlatformWindowSurfaceEXT"));
+  if (!createPlatformWindowSurface) {
+    return fail(Errc::kUnavailable,
+                fmt::format("cannot make an EGL surface for {}: EGL has no eglCreatePlatformWindowSurfaceEXT", what));
+  }
+  const EGLSurface surface = createPlatformWindowSurface(display->handle(), config, nativeWindow, nullptr);
+  if (surface == EGL_NO_SURFACE) {
+    return fail(Errc::kUnavailable,
+                fmt::format("cannot make an EGL surface for {} ({})", what, eglErrorName(eglGetError())));
+  }
+  return EglSurface(std::move(display), surface);
+}
+
+EglSurface EglSurface::wrap(std::shared_ptr<EglDisplay> display, EGLSurface surface) {
+  if (surface == EGL_NO_SURFACE) return {};
+  return EglSurface(std::move(display), surface);
+}
+
+EglSurface::EglSurface(EglSurface&& other) noexcept
+    : display_(std::move(other.display_)), surface_(std::exchange(other.surface_, EGL_NO_SURFACE)) {}
+
+EglSurface& EglSurface::operator=(EglSurface&& other) noexcept {
+  if (this != &other) {
+    reset();
+    display_ = std::move(other.display_);
+    surface_ = std::exchange(other.surface_, EGL_NO_SURFACE);
+  }
+  return *this;
+}
+
+EGLSurface EglSurface::release() {
+  display_.reset();
+  return std::exchange(surface_, EGL_NO_SURFACE);
+}
+
+void EglSurface::reset() {
+  if (surface_ == EGL_NO_SURFACE) return;
+  const EGLDisplay display = display_->handle();
+  if (eglGetCurrentDisplay() == display &&
+      (eglGetCurrentSurface(EGL_DRAW) == surface_ || eglGetCurrentSurface(EGL_READ) == surface_)) {
+    // EGL destroys a current surface only once it stops being current: let go of it now, keeping
+    // the context where surfaceless contexts are allowed.
+    const EGLContext context = eglGetCurrentContext();
+    if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)) {
+      eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    }
+  }
+  eglDestroySurface(display, surface_);
+  surface_ = EGL_NO_SURFACE;
+  display_.reset();
 }
 
 }  // namespace basalt::render

@@ -98,7 +98,7 @@ struct KmsOutput::State {
   drm::GbmDevice gbm;
   drm::GbmSurface surface;
   std::unique_ptr<EglContext> context;
-  EGLSurface eglSurface = EGL_NO_SURFACE;
+  EglSurface eglSurface;  // on `surface`
   std::string renderer;
 
   std::uint32_t connectorId = 0;
@@ -139,12 +139,8 @@ struct KmsOutput::State {
       if (pending) gbm_surface_release_buffer(surface.get(), pending);
       if (onScreen) gbm_surface_release_buffer(surface.get(), onScreen);
     }
-    if (context) {
-      const EGLDisplay display = context->display()->handle();
-      eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-      if (eglSurface != EGL_NO_SURFACE) eglDestroySurface(display, eglSurface);
-    }
-    context.reset();  // and with it the EGL display, before the GBM device it was made on
+    eglSurface.reset();  // before the GBM surface under it
+    context.reset();     // and with it the EGL display, before the GBM device it was made on
     surface.reset();
     gbm.reset();
     if (modeBlob && fd) drmModeDestroyPropertyBlob(fd.get(), modeBlob);
@@ -460,12 +456,10 @@ Result<std::unique_ptr<KmsOutput>> KmsOutput::open(const OutputRequest& request)
   auto context = EglContext::create(*display, *config);
   if (!context) return std::unexpected(context.error());
   s.context = std::move(*context);
-  s.eglSurface = eglCreateWindowSurface((*display)->handle(), *config,
-                                        reinterpret_cast<EGLNativeWindowType>(s.surface.get()), nullptr);
-  if (s.eglSurface == EGL_NO_SURFACE) {
-    return fail(Errc::kUnavailable, fmt::format("cannot make an EGL surface on GBM ({})", eglErrorName(eglGetError())));
-  }
-  if (auto r = s.context->makeCurrent(s.eglSurface); !r) return std::unexpected(r.error());
+  auto eglSurface = EglSurface::createWindow(*display, *config, s.surface.get(), "GBM on " + s.devicePath);
+  if (!eglSurface) return std::unexpected(eglSurface.error());
+  s.eglSurface = std::move(*eglSurface);
+  if (auto r = s.context->makeCurrent(s.eglSurface.handle()); !r) return std::unexpected(r.error());
   s.renderer = gl::rendererDescription();
   s.events.version = 2;
   s.events.page_flip_handler = &State::onFlip;
@@ -515,7 +509,7 @@ Result<void> KmsOutput::present() {
   if (s.pending) {
     if (auto r = waitForFlip(1000); !r) return r;
   }
-  if (!eglSwapBuffers(s.context->display()->handle(), s.eglSurface)) {
+  if (!eglSwapBuffers(s.context->display()->handle(), s.eglSurface.handle())) {
     return fail(Errc::kIo, fmt::format("eglSwapBuffers failed ({})", eglErrorName(eglGetError())));
   }
   gbm_bo* bo = gbm_surface_lock_front_buffer(s.surface.get());

@@ -169,13 +169,9 @@ Result<GLuint> keptProgram(const std::string& key, gl::Program& owned, Build&& b
   if (const GLuint kept = context ? context->keptProgram(key) : 0; kept != 0) return kept;
   Result<gl::Program> program = std::forward<Build>(build)();
   if (!program) return std::unexpected(program.error());
-  const GLuint id = program->id();
-  if (context) {
-    context->keepProgram(key, program->release());
-  } else {
-    owned = std::move(*program);
-  }
-  return id;
+  if (context) return context->keepProgram(key, std::move(*program));
+  owned = std::move(*program);
+  return owned.id();
 }
 
 /// The conversion program for one layout: the current EGL context's copy (compiled once for all

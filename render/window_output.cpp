@@ -47,7 +47,7 @@ struct WindowOutput::State {
   Atom deleteAtom = 0;
   Size size;
   std::unique_ptr<EglContext> context;
-  EGLSurface surface = EGL_NO_SURFACE;
+  EglSurface surface;  // on `window`
   std::string renderer;
   bool closeRequested = false;
   // Input received and not taken yet: a fixed ring, so that receiving allocates nothing; the
@@ -75,11 +75,7 @@ struct WindowOutput::State {
   }
 
   ~State() {
-    if (context) {
-      const EGLDisplay display = context->display()->handle();
-      eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-      if (surface != EGL_NO_SURFACE) eglDestroySurface(display, surface);
-    }
+    surface.reset();  // before the window under it
     context.reset();  // the EGL display goes with it, before the X connection it uses
     if (xDisplay && window) XDestroyWindow(xDisplay.get(), window);
     if (xDisplay && colormap) XFreeColormap(xDisplay.get(), colormap);
@@ -103,7 +99,7 @@ Result<void> WindowOutput::beginFrame() {
 }
 
 Result<void> WindowOutput::present() {
-  if (!eglSwapBuffers(state_->context->display()->handle(), state_->surface)) {
+  if (!eglSwapBuffers(state_->context->display()->handle(), state_->surface.handle())) {
     return fail(Errc::kIo, fmt::format("eglSwapBuffers on the window failed ({})", eglErrorName(eglGetError())));
   }
   handleEvents();
@@ -274,12 +270,10 @@ Result<std::unique_ptr<WindowOutput>> WindowOutput::open(const OutputRequest& re
   if (!context) return std::unexpected(context.error());
   state->context = std::move(*context);
   Window nativeWindow = window;
-  state->surface = eglCreateWindowSurface((*display)->handle(), config, nativeWindow, nullptr);
-  if (state->surface == EGL_NO_SURFACE) {
-    return fail(Errc::kUnavailable,
-                fmt::format("cannot make an EGL surface for the window ({})", eglErrorName(eglGetError())));
-  }
-  if (auto r = state->context->makeCurrent(state->surface); !r) return std::unexpected(r.error());
+  auto surface = EglSurface::createWindow(*display, config, &nativeWindow, "the window");
+  if (!surface) return std::unexpected(surface.error());
+  state->surface = std::move(*surface);
+  if (auto r = state->context->makeCurrent(state->surface.handle()); !r) return std::unexpected(r.error());
   eglSwapInterval(state->context->display()->handle(), 0);  // the frame loop paces itself
   state->renderer = gl::rendererDescription();
   return std::unique_ptr<WindowOutput>(new WindowOutput(std::move(state)));

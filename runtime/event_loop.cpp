@@ -6,8 +6,13 @@
 #include <sys/timerfd.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <climits>
+#include <cstdlib>
+#include <string_view>
+
+#include "runtime/log.h"
 
 namespace basalt::runtime {
 namespace {
@@ -17,6 +22,54 @@ namespace {
 constexpr std::uint64_t kWakeTag = UINT64_MAX;
 constexpr std::uint64_t kTimerTag = UINT64_MAX - 1;
 constexpr std::uint64_t kSignalTag = UINT64_MAX - 2;
+
+BASALT_LOG_CATEGORY(Runtime, "runtime");
+
+// Which wait call the process uses. epoll_pwait2 (Linux 5.11) takes a timespec; where it is
+// missing (older kernels, valgrind) epoll_pwait with whole milliseconds does. Decided by the
+// first wait and kept for the life of the process.
+enum class WaitCall : int { kUndecided, kPwait2, kPwait };
+std::atomic<WaitCall> gWaitCall{WaitCall::kUndecided};
+
+bool pwait2DisabledByEnvironment() {
+  const char* value = std::getenv("BASALT_NO_EPOLL_PWAIT2");
+  return value != nullptr && std::string_view(value) == "1";
+}
+
+// Rounded up: a wait cut short by rounding down would return before the deadline and make
+// the caller spin until it arrives.
+int timeoutMilliseconds(Nanos wait) {
+  if (wait <= Nanos{0}) return 0;
+  const std::int64_t ms = (wait.count() + 999'999) / 1'000'000;
+  return ms > INT_MAX ? INT_MAX : static_cast<int>(ms);
+}
+
+int waitForEvents(int epollFd, epoll_event* events, int maxEvents, Nanos wait) {
+  WaitCall call = gWaitCall.load(std::memory_order_relaxed);
+  if (call == WaitCall::kUndecided && pwait2DisabledByEnvironment()) {
+    call = WaitCall::kPwait;
+    gWaitCall.store(call, std::memory_order_relaxed);
+    log::info(kLogRuntime, "the event loop waits with epoll_pwait (BASALT_NO_EPOLL_PWAIT2=1)");
+  }
+  if (call != WaitCall::kPwait) {
+    timespec timeout{};
+    timeout.tv_sec = static_cast<time_t>(wait.count() / 1'000'000'000);
+    timeout.tv_nsec = static_cast<long>(wait.count() % 1'000'000'000);
+    const int n = epoll_pwait2(epollFd, events, maxEvents, &timeout, nullptr);
+    if (n >= 0 || errno != ENOSYS) {
+      if (call == WaitCall::kUndecided && n >= 0) gWaitCall.store(WaitCall::kPwait2, std::memory_order_relaxed);
+      return n;
+    }
+    gWaitCall.store(WaitCall::kPwait, std::memory_order_relaxed);
+    static log::Once said;
+    if (said.first()) {
+      log::info(kLogRuntime,
+                "epoll_pwait2 is not available (Linux before 5.11?); the event loop waits with "
+                "epoll_pwait, to the millisecond");
+    }
+  }
+  return epoll_pwait(epollFd, events, maxEvents, timeoutMilliseconds(wait), nullptr);
+}
 
 Result<void> addToEpoll(int epollFd, int fd, std::uint32_t events, std::uint64_t tag) {
   epoll_event ev{};
@@ -40,6 +93,10 @@ Result<std::unique_ptr<EventLoop>> EventLoop::create(const Clock& clock) {
   if (auto r = addToEpoll(epollFd.get(), wakeFd.get(), EPOLLIN, kWakeTag); !r) return std::unexpected(r.error());
   if (auto r = addToEpoll(epollFd.get(), timerFd.get(), EPOLLIN, kTimerTag); !r) return std::unexpected(r.error());
   return std::unique_ptr<EventLoop>(new EventLoop(clock, std::move(epollFd), std::move(wakeFd), std::move(timerFd)));
+}
+
+const char* EventLoop::waitCallName() {
+  return gWaitCall.load(std::memory_order_relaxed) == WaitCall::kPwait ? "epoll_pwait" : "epoll_pwait2";
 }
 
 EventLoop::EventLoop(const Clock& clock, UniqueFd epoll, UniqueFd wakeFd, UniqueFd timerFd)
@@ -154,13 +211,10 @@ Result<int> EventLoop::dispatch(Nanos maxWait) {
     const Nanos next = nextDeadline();
     if (next != Nanos::max()) wait = std::min(wait, std::max(Nanos{0}, next - clock_.now()));
   }
-  timespec timeout{};
-  timeout.tv_sec = static_cast<time_t>(wait.count() / 1'000'000'000);
-  timeout.tv_nsec = static_cast<long>(wait.count() % 1'000'000'000);
-  const int n = epoll_pwait2(epoll_.get(), ready_.data(), static_cast<int>(ready_.size()), &timeout, nullptr);
+  const int n = waitForEvents(epoll_.get(), ready_.data(), static_cast<int>(ready_.size()), wait);
   if (n < 0) {
     if (errno == EINTR) return ran;
-    return fail(Errc::kIo, systemErrorText("epoll_pwait2", errno));
+    return fail(Errc::kIo, systemErrorText(waitCallName(), errno));
   }
   for (int i = 0; i < n; ++i) {
     const epoll_event& ev = ready_[static_cast<std::size_t>(i)];

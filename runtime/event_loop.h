@@ -63,6 +63,11 @@ class EventLoop {
   /// \brief The earliest pending timer deadline, or Nanos::max() when there is none.
   [[nodiscard]] Nanos nextDeadline() const;
 
+  /// \brief The system call the loops of this process wait with: "epoll_pwait2", or
+  /// "epoll_pwait" where that is missing (Linux before 5.11, valgrind) or
+  /// BASALT_NO_EPOLL_PWAIT2=1 asks for it. Decided by the first wait of any loop.
+  [[nodiscard]] static const char* waitCallName();
+
  private:
   EventLoop(const Clock& clock, UniqueFd epoll, UniqueFd wakeFd, UniqueFd timerFd);
   int runDueTimers();

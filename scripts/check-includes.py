@@ -34,6 +34,7 @@ LIBRARIES = [
     (re.compile(r"^httplib\.h$"), "cpp-httplib", "kiosk/status"),
     (re.compile(r"^systemd/"), "libsystemd", "kiosk/policy"),
     (re.compile(r"^toml\+\+/"), "toml++", "kiosk/manifest"),
+    (re.compile(r"^cctz/"), "cctz", "kiosk/manifest"),
     (re.compile(r"^(gst|glib|glib-object)/|^glib\.h$"), "GStreamer/GLib", "media"),
     (re.compile(r"^OpenImageIO/"), "OpenImageIO", "media"),
     (re.compile(r"^(EGL|GLES2|GLES3|KHR)/|^(gbm\.h|xf86drm\.h|xf86drmMode\.h)$"), "EGL/GLES/GBM/DRM", "render"),

@@ -1,10 +1,18 @@
 #!/usr/bin/env bash
-# Installs every Debian package Basalt needs (scripts/packages.txt), idempotently:
-# when all are present it does nothing and touches no network.
-# Runs as root, or through sudo when it is available.
+# Installs the Debian packages Basalt needs, idempotently: when all are present it does nothing and
+# touches no network. Runs as root, or through sudo when it is available.
+#   scripts/setup.sh          what building and running Basalt needs (scripts/packages.txt): make run
+#   scripts/setup.sh --test   that and what the tests, benchmarks, lint, fuzzing and the virtual lab
+#                             need (scripts/packages-test.txt): make test and the other targets, CI
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-mapfile -t wanted < <(grep -vE '^\s*(#|$)' "$here/packages.txt")
+lists=("$here/packages.txt")
+case "${1:-}" in
+  "") ;;
+  --test) lists+=("$here/packages-test.txt") ;;
+  *) echo "usage: scripts/setup.sh [--test]" >&2; exit 2 ;;
+esac
+mapfile -t wanted < <(grep -hvE '^\s*(#|$)' "${lists[@]}")
 missing=()
 for pkg in "${wanted[@]}"; do
   status=$(dpkg-query -W -f='${db:Status-Status}' "$pkg" 2>/dev/null || true)

@@ -4,15 +4,23 @@
 
 #include "sim/trace.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 
+#include "sim/hid_comments.h"
 #include "sim/hid_recording.h"
 #include "sim/raw_video.h"
 
@@ -329,20 +337,139 @@ Result<TraceInfo> readTrace(const std::filesystem::path& folder) {
 
 // TraceRecorder
 
+namespace {
+
+/// The mark a recording keeps in its folder while it runs, locked with flock: a folder whose
+/// mark nobody holds was left by a recording that never finished.
+constexpr std::string_view kMarkName = ".recording";
+
+/// Whether a file in a trace folder is one a recording writes before trace.toml.
+bool writtenWhileRecording(const std::filesystem::path& name) {
+  const std::filesystem::path ext = name.extension();
+  return name == kMarkName || ext == ".hid" || ext == ".mkv" || ext == ".bvraw";
+}
+
+/// Opens (or creates) the mark and takes its lock; false in `busy` when another process holds it.
+Result<UniqueFd> lockMark(const std::filesystem::path& mark, bool& busy) {
+  busy = false;
+  UniqueFd fd(::open(mark.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644));
+  if (!fd) return fail(Errc::kIo, fmt::format("cannot create {}: {}", mark.string(), std::strerror(errno)));
+  if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) {
+    busy = errno == EWOULDBLOCK;
+    if (!busy) return fail(Errc::kIo, fmt::format("cannot lock {}: {}", mark.string(), std::strerror(errno)));
+  }
+  return fd;
+}
+
+/// What the mark says about the recording that holds it ("pid 1234 on kiosk-3").
+std::string markText(const std::filesystem::path& mark) {
+  std::ifstream in(mark);
+  std::string line;
+  std::getline(in, line);
+  return line.size() > 200 ? line.substr(0, 200) : line;
+}
+
+}  // namespace
+
 Result<std::unique_ptr<TraceRecorder>> TraceRecorder::create(const std::filesystem::path& folder, const Clock& clock,
                                                              Options options) {
   std::error_code ec;
-  if (std::filesystem::exists(folder, ec) && !std::filesystem::is_empty(folder, ec)) {
-    return fail(Errc::kInvalidArgument, "the trace folder exists and is not empty; choose a new name", folder.string());
+  const std::filesystem::path mark = folder / kMarkName;
+  const bool existed = std::filesystem::exists(folder, ec);
+  std::vector<std::filesystem::path> leftOver;
+  UniqueFd markFd;
+  if (existed) {
+    if (!std::filesystem::is_directory(folder, ec)) {
+      return fail(Errc::kInvalidArgument, "this is a file, not a folder; record into a new folder", folder.string());
+    }
+    bool finished = false;
+    std::vector<std::string> foreign;
+    std::size_t seen = 0;
+    for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end && seen < 10000; it.increment(ec)) {
+      ++seen;
+      const std::filesystem::path name = it->path().filename();
+      if (name == "trace.toml") {
+        finished = true;
+      } else if (it->is_regular_file(ec) && writtenWhileRecording(name)) {
+        leftOver.push_back(name);
+      } else {
+        foreign.push_back(name.string());
+      }
+    }
+    if (ec) return fail(Errc::kIo, "cannot list the trace folder: " + ec.message(), folder.string());
+    std::sort(leftOver.begin(), leftOver.end());
+    if (finished) {
+      return fail(Errc::kInvalidArgument,
+                  "this folder holds a finished trace (it has trace.toml); record into another folder, or remove "
+                  "this one to record it again",
+                  folder.string());
+    }
+    if (!foreign.empty()) {
+      std::sort(foreign.begin(), foreign.end());
+      std::string names;
+      for (std::size_t i = 0; i < std::min<std::size_t>(foreign.size(), 3); ++i) names += (i ? ", " : "") + foreign[i];
+      if (foreign.size() > 3) names += fmt::format(" and {} more", foreign.size() - 3);
+      return fail(
+          Errc::kInvalidArgument,
+          fmt::format("this folder is not empty and is not a trace (it holds {}); record into a new folder", names),
+          folder.string());
+    }
+    if (!leftOver.empty()) {
+      // An unfinished trace: replaced, unless its recording is still running.
+      bool busy = false;
+      auto locked = lockMark(mark, busy);
+      if (!locked) return std::unexpected(locked.error());
+      if (busy) {
+        const std::string who = markText(mark);
+        return fail(Errc::kUnavailable,
+                    fmt::format("another 'basalt record' is writing this trace now{}; wait for it to finish, or record "
+                                "into another folder",
+                                who.empty() ? std::string() : " (" + who + ")"),
+                    folder.string());
+      }
+      markFd = std::move(*locked);
+    }
   }
   std::filesystem::create_directories(folder, ec);
   if (ec) return fail(Errc::kIo, "cannot create the trace folder: " + ec.message(), folder.string());
+  std::vector<std::string> replaced;
+  for (const std::filesystem::path& name : leftOver) {
+    if (name == kMarkName) continue;  // kept: it is this recording's mark now
+    std::filesystem::remove(folder / name, ec);
+    if (ec) {
+      return fail(Errc::kIo,
+                  fmt::format("cannot remove {} of an unfinished recording: {}", name.string(), ec.message()),
+                  folder.string());
+    }
+    replaced.push_back(name.string());
+  }
+  if (!markFd) {
+    bool busy = false;
+    auto locked = lockMark(mark, busy);
+    if (!locked) return std::unexpected(locked.error());
+    if (busy) return fail(Errc::kUnavailable, "another 'basalt record' started writing this trace", folder.string());
+    markFd = std::move(*locked);
+  }
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  const std::string text = fmt::format("pid {} on {}\n", ::getpid(), host);
+  if (::ftruncate(markFd.get(), 0) != 0 || ::pwrite(markFd.get(), text.data(), text.size(), 0) < 0) {
+    return fail(Errc::kIo, fmt::format("cannot write {}: {}", mark.string(), std::strerror(errno)));
+  }
   if (!options.videoWriter) options.videoWriter = rawVideoWriterFactory();
-  return std::unique_ptr<TraceRecorder>(new TraceRecorder(folder, clock, std::move(options)));
+  return std::unique_ptr<TraceRecorder>(
+      new TraceRecorder(folder, clock, std::move(options), std::move(markFd), !existed, std::move(replaced)));
 }
 
-TraceRecorder::TraceRecorder(std::filesystem::path folder, const Clock& clock, Options options)
-    : folder_(std::move(folder)), clock_(clock), options_(std::move(options)), start_(clock.now()) {
+TraceRecorder::TraceRecorder(std::filesystem::path folder, const Clock& clock, Options options, UniqueFd mark,
+                             bool madeFolder, std::vector<std::string> replaced)
+    : folder_(std::move(folder)),
+      clock_(clock),
+      options_(std::move(options)),
+      mark_(std::move(mark)),
+      madeFolder_(madeFolder),
+      replaced_(std::move(replaced)),
+      start_(clock.now()) {
   info_.folder = folder_;
   info_.host = options_.host;
   info_.basalt = options_.basaltVersion;
@@ -374,12 +501,18 @@ Result<void> TraceRecorder::addDialBox(DeviceId id, const std::string& name, con
   if (!f.out) return fail(Errc::kIo, "cannot create the recording file", (folder_ / d.file).string());
   HidRecordedDevice header;
   header.name = info.name;
+  header.phys = hidPhysicalPath(info);
   header.bus = info.bus == "usb" ? 3 : (info.bus == "bluetooth" ? 5 : 6);
   header.vendor = info.vendor;
   header.product = info.product;
   header.descriptor = descriptor;
+  // As hid-recorder begins: the name, then the descriptor item by item, then the R: N: P: I:
+  // lines; each report's E: line comes after a comment that decodes it.
+  f.comments = HidComments::create(descriptor);
+  f.out << "# " << info.name << "\n";
   f.out << "# Recorded by " << options_.basaltVersion << " (basalt record) from " << devices::describeDevice(info)
         << "\n";
+  f.out << f.comments.descriptorLines();
   f.out << HidRecordingWriter::header(header, false);
   f.index = info_.devices.size();
   info_.devices.push_back(std::move(d));
@@ -411,7 +544,7 @@ void TraceRecorder::onReport(DeviceId device, Nanos time, std::span<const std::u
   if (stopping_) return;
   auto it = dials_.find(device);
   if (it == dials_.end()) return;
-  it->second.out << HidRecordingWriter::reportLine(time - start_, report);
+  it->second.out << it->second.comments.reportLine(report) << HidRecordingWriter::reportLine(time - start_, report);
   if (!it->second.out)
     noteError(Error(Errc::kIo, "cannot write the recording (disk full?)", info_.devices[it->second.index].file));
   ++reports_;
@@ -467,17 +600,25 @@ bool TraceRecorder::drain(std::chrono::milliseconds timeout) {
   return framesDone_.wait_for(lock, timeout, [this] { return frames_.empty() && !writing_; });
 }
 
-Result<TraceInfo> TraceRecorder::finish() {
+void TraceRecorder::stopWriting() {
   {
     std::lock_guard lock(mutex_);
-    if (stopping_ && !writer_.joinable()) {
-      if (firstError_) return std::unexpected(*firstError_);
-      return info_;
-    }
     stopping_ = true;
   }
   framesReady_.notify_all();
   if (writer_.joinable()) writer_.join();
+}
+
+Result<TraceInfo> TraceRecorder::finish() {
+  {
+    std::lock_guard lock(mutex_);
+    if (discarded_) return fail(Errc::kInvalidArgument, "the recording was discarded", folder_.string());
+    if (stopping_ && !writer_.joinable()) {
+      if (firstError_) return std::unexpected(*firstError_);
+      return info_;
+    }
+  }
+  stopWriting();
   std::lock_guard lock(mutex_);
   for (auto& [id, f] : dials_) {
     f.out.flush();
@@ -493,7 +634,53 @@ Result<TraceInfo> TraceRecorder::finish() {
   toml.close();
   if (!toml) noteError(Error(Errc::kIo, "cannot write trace.toml", folder_.string()));
   if (firstError_) return std::unexpected(*firstError_);
+  // Finished: the mark goes, so that the folder reads as a finished trace.
+  std::error_code ec;
+  std::filesystem::remove(folder_ / kMarkName, ec);
+  mark_.reset();
   return info_;
+}
+
+void TraceRecorder::discard() {
+  const bool finishing = [&] {
+    std::lock_guard lock(mutex_);
+    return !stopping_;
+  }();
+  stopWriting();
+  std::lock_guard lock(mutex_);
+  if (discarded_) return;
+  discarded_ = true;
+  if (finishing) {
+    // Close what is open before it is removed (a video writer's pipeline holds its file).
+    for (auto& [id, f] : dials_) f.out.close();
+    for (auto& [id, f] : videos_) {
+      if (auto r = f.writer->finish(); !r) noteError(r.error());
+    }
+  }
+  std::error_code ec;
+  for (const TraceDevice& d : info_.devices) {
+    if (!d.file.empty()) std::filesystem::remove(folder_ / d.file, ec);
+  }
+  std::filesystem::remove(folder_ / "trace.toml", ec);
+  std::filesystem::remove(folder_ / kMarkName, ec);
+  mark_.reset();
+  // The folder goes too when this recording made it (remove() leaves a folder that is not empty).
+  if (madeFolder_) std::filesystem::remove(folder_, ec);
+}
+
+std::uint64_t TraceRecorder::bytesWritten() const {
+  std::vector<std::filesystem::path> files;
+  {
+    std::lock_guard lock(mutex_);
+    for (const TraceDevice& d : info_.devices) files.push_back(folder_ / d.file);
+  }
+  std::uint64_t bytes = 0;
+  for (const std::filesystem::path& f : files) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(f, ec);
+    if (!ec) bytes += size;
+  }
+  return bytes;
 }
 
 std::uint64_t TraceRecorder::reportsWritten() const {

@@ -24,6 +24,8 @@
 #include "devices/video_source.h"
 #include "runtime/clock.h"
 #include "runtime/error.h"
+#include "runtime/unique_fd.h"
+#include "sim/hid_comments.h"
 #include "sim/trace_video.h"
 
 namespace basalt::sim {
@@ -70,7 +72,12 @@ class TraceRecorder final : public devices::ReportTap, public devices::FrameTap 
     TraceVideoWriterFactory videoWriter;  ///< default: raw .bvraw files
   };
 
-  /// \brief Creates `folder` (which must not exist or be empty) and starts the recording clock.
+  /// \brief Creates `folder` and starts the recording clock. The folder must not exist, be
+  /// empty, or hold an unfinished trace: the files a recording that never finished left (no
+  /// trace.toml, only .hid, .mkv and .bvraw files and its `.recording` mark), which are removed
+  /// (replacedFiles() names them). A folder that holds a finished trace, other files, or a
+  /// recording in progress (another process holds its `.recording` mark) is refused with a
+  /// message that names the folder and what to do.
   [[nodiscard]] static Result<std::unique_ptr<TraceRecorder>> create(const std::filesystem::path& folder,
                                                                      const Clock& clock, Options options);
   ~TraceRecorder() override;
@@ -91,19 +98,30 @@ class TraceRecorder final : public devices::ReportTap, public devices::FrameTap 
 
   /// \brief Stops, flushes every file and writes trace.toml. The first write error, if any.
   [[nodiscard]] Result<TraceInfo> finish();
+  /// \brief For a trace that cannot be finished: stops and removes every file of the recording,
+  /// and the folder when create() made it. Idempotent; after finish() too.
+  void discard();
+
+  /// \brief The files of an earlier, unfinished recording that create() removed.
+  [[nodiscard]] const std::vector<std::string>& replacedFiles() const { return replaced_; }
+  /// \brief Bytes in the trace's files now (what they take on disk as far as written).
+  [[nodiscard]] std::uint64_t bytesWritten() const;
 
   [[nodiscard]] std::uint64_t reportsWritten() const;
   [[nodiscard]] std::uint64_t framesWritten() const;
   [[nodiscard]] std::uint64_t framesDropped() const;
 
  private:
-  TraceRecorder(std::filesystem::path folder, const Clock& clock, Options options);
+  TraceRecorder(std::filesystem::path folder, const Clock& clock, Options options, UniqueFd mark, bool madeFolder,
+                std::vector<std::string> replaced);
+  void stopWriting();
   void writerLoop();
   void noteError(const Error& e);
 
   struct DialFile {
     std::ofstream out;
     std::size_t index = 0;  // in info_.devices
+    HidComments comments;   // decodes each report into the comment before its E: line
   };
   struct VideoFile {
     std::unique_ptr<TraceVideoWriter> writer;
@@ -117,6 +135,10 @@ class TraceRecorder final : public devices::ReportTap, public devices::FrameTap 
   std::filesystem::path folder_;
   const Clock& clock_;
   Options options_;
+  UniqueFd mark_;    // `.recording`, locked (flock) while this recording runs
+  bool madeFolder_;  // create() made the folder (discard() removes it)
+  std::vector<std::string> replaced_;
+  bool discarded_ = false;
   Nanos start_{0};
   mutable std::mutex mutex_;  // guards everything below
   TraceInfo info_;

@@ -11,9 +11,13 @@
 
 #include <fmt/format.h>
 
+#include "runtime/log.h"
+
 namespace basalt::devices {
 
 namespace {
+
+BASALT_LOG_CATEGORY(Hid, "devices");
 
 using hid::ReportField;
 namespace u = hid::usages;
@@ -83,6 +87,9 @@ Result<DialDecoder> DialDecoder::create(std::uint16_t vendor, std::uint16_t prod
   }
   auto parsed = hid::parseReportDescriptor(descriptor, where);
   if (!parsed) return std::unexpected(parsed.error());
+  for (const std::string& note : parsed->ignored) {
+    log::debug(kLogHid, "{}: report descriptor {} (skipped)", where, note);
+  }
   d.descriptor_ = std::move(*parsed);
   const auto& fields = d.descriptor_.fields;
 

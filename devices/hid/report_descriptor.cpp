@@ -4,6 +4,13 @@
 // Limits (generous for real devices, small enough that a hostile descriptor cannot exhaust
 // memory): 1024 fields, 64 nested collections, 16 pushed global states, 1024-bit elements,
 // 65536 bits per field, 4096 usages per main item.
+//
+// What Linux's parser (drivers/hid/hid-core.c) accepts is accepted: main items with a reserved
+// tag (a trailing 0x00 pad byte is one), items of the reserved type and local items with a
+// reserved tag are skipped, and a Usage Maximum below its Usage Minimum adds no usage. Long items
+// (0xfe, defined by HID 1.11 but without any tag in use) are skipped by their length; Linux
+// refuses them. Global items with a reserved tag are refused, as Linux refuses them. What was
+// skipped is listed in `ignored`.
 
 #include "devices/hid/report_descriptor.h"
 
@@ -24,6 +31,7 @@ constexpr std::size_t kMaxPushDepth = 16;
 constexpr std::uint32_t kMaxReportSize = 1024;
 constexpr std::uint64_t kMaxFieldBits = 65536;
 constexpr std::size_t kMaxUsages = 4096;
+constexpr std::size_t kMaxIgnoredNotes = 16;  // further skipped items are counted, not described
 
 struct Globals {
   std::uint16_t usagePage = 0;
@@ -121,6 +129,10 @@ Result<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> byt
   Locals locals;
   std::vector<int> open;                            // indices of open collections
   std::map<std::uint32_t, std::uint32_t> bitsUsed;  // (type << 8 | id) -> bits so far
+  std::size_t ignoredCount = 0;
+  auto skip = [&](std::size_t offset, std::string what) {
+    if (++ignoredCount <= kMaxIgnoredNotes) out.ignored.push_back(fmt::format("byte {}: {}", offset, what));
+  };
 
   std::size_t pos = 0;
   while (pos < bytes.size()) {
@@ -129,8 +141,10 @@ Result<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> byt
     if (prefix == 0xfe) {  // long item: size, tag, data
       if (pos + 2 > bytes.size()) return bad(itemStart, "a long item is cut short");
       const std::size_t size = bytes[pos];
+      const std::uint8_t longTag = bytes[pos + 1];
       pos += 2 + size;
       if (pos > bytes.size()) return bad(itemStart, "a long item is cut short");
+      skip(itemStart, fmt::format("long item with tag 0x{:02x} and {} data byte(s)", longTag, size));
       continue;
     }
     static constexpr std::array<int, 4> kSizes = {0, 1, 2, 4};
@@ -222,7 +236,9 @@ Result<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> byt
         if (open.empty()) return bad(itemStart, "End Collection without an open collection");
         open.pop_back();
       } else {
-        return bad(itemStart, fmt::format("unknown main item 0x{:02x}", prefix));
+        // Reserved main tags, 0x00 padding among them; Linux skips them and so do we. Like any
+        // main item they end the local state.
+        skip(itemStart, fmt::format("main item 0x{:02x} with a reserved tag", prefix));
       }
       locals.clear();
     } else if (type == 1) {  // global
@@ -280,23 +296,42 @@ Result<ReportDescriptor> parseReportDescriptor(std::span<const std::uint8_t> byt
           locals.haveMin = true;
           break;
         case 0x2: {
+          // Linux counts from usage 0 without a minimum, which with any usage page runs past its
+          // usage limit and refuses the descriptor; refused here too. A maximum below its
+          // minimum adds no usage (Linux).
           if (!locals.haveMin) return bad(itemStart, "Usage Maximum without Usage Minimum");
+          const std::uint32_t min = locals.pendingMin;
           const std::uint32_t max = fullUsage(value, size, g.usagePage);
-          if (max < locals.pendingMin) return bad(itemStart, "Usage Maximum below Usage Minimum");
+          if (max < min) {
+            skip(itemStart, "Usage Maximum below its Usage Minimum; no usages");
+            locals.haveMin = false;
+            break;
+          }
           if (locals.total >= kMaxUsages) return bad(itemStart, "more than 4096 usages before one main item");
-          locals.usages.push_back({locals.pendingMin, max});
+          locals.usages.push_back({min, max});
           locals.total += 1;
           locals.haveMin = false;
           break;
         }
-        default: break;  // designators, strings and delimiters do not change the layout
+        case 0x3:
+        case 0x4:
+        case 0x5:
+        case 0x7:
+        case 0x8:
+        case 0x9:
+        case 0xa: break;  // designators, strings and delimiters do not change the layout
+        default: skip(itemStart, fmt::format("local item 0x{:02x} with a reserved tag", prefix)); break;
       }
     } else {
-      return bad(itemStart, fmt::format("reserved item type in 0x{:02x}", prefix));
+      // A short item of the reserved type (0xfe, the long item, is handled above): skipped.
+      skip(itemStart, fmt::format("item 0x{:02x} of the reserved type", prefix));
     }
   }
   if (!open.empty()) {
     return bad(bytes.size(), fmt::format("the descriptor ends inside {} open collection(s)", open.size()));
+  }
+  if (ignoredCount > kMaxIgnoredNotes) {
+    out.ignored.push_back(fmt::format("{} more skipped item(s)", ignoredCount - kMaxIgnoredNotes));
   }
   return out;
 }

@@ -96,6 +96,9 @@ struct ReportDescriptor {
   std::vector<ReportField> fields;
   std::vector<Collection> collections;
   bool usesReportIds = false;
+  /// Items skipped (reserved tags and types, 0x00 padding and long items, see the parser), one
+  /// line each ("byte 41: main item 0x00 with a reserved tag"); at most 17 lines.
+  std::vector<std::string> ignored;
 
   /// \brief Bytes of report `id` of `type`, without the id byte.
   [[nodiscard]] std::size_t reportBytes(ReportType type, std::uint8_t id) const;

@@ -25,11 +25,9 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <condition_variable>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -39,6 +37,7 @@
 
 #include <fmt/format.h>
 
+#include "devices/v4l2/v4l2_buffer_set.h"
 #include "runtime/log.h"
 #include "runtime/unique_fd.h"
 
@@ -171,73 +170,6 @@ void usbIds(const std::string& path, std::uint16_t& vendor, std::uint16_t& produ
   }
 }
 
-/// The mmap'd (and exported) buffers of one negotiation. Frames out in the show hold a reference
-/// each (refs_), the camera one more; the last release unmaps. Buffers are re-queued on release
-/// while the set is streaming. Threading: refs_ and streaming_ are atomics; QBUF from any thread
-/// under qbufMutex_.
-class BufferSet {
- public:
-  struct Buffer {
-    void* data = MAP_FAILED;
-    std::size_t length = 0;
-    UniqueFd dmabuf;
-  };
-
-  BufferSet(UniqueFd fd, std::vector<Buffer> buffers) : fd_(std::move(fd)), buffers_(std::move(buffers)) {}
-  ~BufferSet() {
-    for (Buffer& b : buffers_) {
-      if (b.data != MAP_FAILED) ::munmap(b.data, b.length);
-    }
-  }
-
-  void ref() { refs_.fetch_add(1, std::memory_order_relaxed); }
-  void unref() {
-    if (refs_.fetch_sub(1, std::memory_order_acq_rel) == 1) delete this;
-  }
-  /// Frames still held by the show (not counting the camera's own reference).
-  [[nodiscard]] int outstanding() const { return refs_.load(std::memory_order_acquire) - 1; }
-
-  bool queue(std::uint32_t index) {
-    std::lock_guard lock(qbufMutex_);
-    if (!streaming_.load(std::memory_order_acquire)) return true;
-    v4l2_buffer b{};
-    b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    b.memory = V4L2_MEMORY_MMAP;
-    b.index = index;
-    return xioctl(fd_.get(), VIDIOC_QBUF, &b) == 0;
-  }
-  void setStreaming(bool on) {
-    std::lock_guard lock(qbufMutex_);
-    streaming_.store(on, std::memory_order_release);
-  }
-
-  static void release(void* context, Frame& frame) {
-    auto* set = static_cast<BufferSet*>(context);
-    (void)set->queue(static_cast<std::uint32_t>(frame.producerCookie));
-    {
-      std::lock_guard lock(set->waitMutex_);
-      set->returned_.notify_all();
-    }
-    set->unref();
-  }
-  /// Waits (capture thread) until the show has given every frame back, or `timeout`.
-  bool waitForFrames(std::chrono::milliseconds timeout) {
-    std::unique_lock lock(waitMutex_);
-    return returned_.wait_for(lock, timeout, [this] { return outstanding() <= 0; });
-  }
-
-  [[nodiscard]] const std::vector<Buffer>& buffers() const { return buffers_; }
-
- private:
-  UniqueFd fd_;  // a duplicate of the camera's, so QBUF works from any thread after close
-  std::vector<Buffer> buffers_;
-  std::atomic<int> refs_{1};
-  std::atomic<bool> streaming_{false};
-  std::mutex qbufMutex_;
-  std::mutex waitMutex_;
-  std::condition_variable returned_;
-};
-
 class V4l2Camera final : public VideoSource {
  public:
   V4l2Camera(DeviceInfo info, std::string path, V4l2Options options, const Clock& clock)
@@ -265,7 +197,7 @@ class V4l2Camera final : public VideoSource {
   std::optional<v4l2_dv_timings> timings_;  // what the receiver was set to, while streaming
   v4l2_pix_format fmt_{};
   VideoMode mode_{};
-  BufferSet* buffers_ = nullptr;  // capture thread (and open/close) only
+  std::shared_ptr<V4l2BufferSet> buffers_;  // capture thread (and open/close) only; shared with lent frames
   std::shared_ptr<FramePool> pool_;
   std::mutex controlMutex_;     // S_CTRL from the manager thread vs renegotiation
   bool qualityWarned_ = false;  // guarded by controlMutex_
@@ -432,7 +364,8 @@ Result<void> V4l2Camera::startStreaming() {
   if (xioctl(fd_.get(), VIDIOC_REQBUFS, &req) != 0 || req.count < 2) {
     return std::unexpected(sysError(path_, "cannot allocate capture buffers", errno));
   }
-  std::vector<BufferSet::Buffer> buffers(req.count);
+  std::vector<V4l2MappedBuffer> buffers;
+  buffers.reserve(req.count);
   bool exported = options_.exportDmabuf;
   for (std::uint32_t i = 0; i < req.count; ++i) {
     v4l2_buffer b{};
@@ -440,29 +373,23 @@ Result<void> V4l2Camera::startStreaming() {
     b.memory = V4L2_MEMORY_MMAP;
     b.index = i;
     if (xioctl(fd_.get(), VIDIOC_QUERYBUF, &b) != 0) return std::unexpected(sysError(path_, "QUERYBUF", errno));
-    buffers[i].length = b.length;
-    buffers[i].data = ::mmap(nullptr, b.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd_.get(), b.m.offset);
-    if (buffers[i].data == MAP_FAILED) {
-      const int e = errno;
-      for (auto& m : buffers) {
-        if (m.data != MAP_FAILED) ::munmap(m.data, m.length);
-      }
-      return std::unexpected(sysError(path_, "cannot map the capture buffers", e));
-    }
+    void* data = ::mmap(nullptr, b.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd_.get(), b.m.offset);
+    if (data == MAP_FAILED) return std::unexpected(sysError(path_, "cannot map the capture buffers", errno));
+    V4l2MappedBuffer& buffer = buffers.emplace_back(data, b.length);
     if (exported) {
       v4l2_exportbuffer x{};
       x.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
       x.index = i;
       x.flags = O_RDONLY | O_CLOEXEC;
       if (xioctl(fd_.get(), VIDIOC_EXPBUF, &x) == 0) {
-        buffers[i].dmabuf.reset(x.fd);
+        buffer.dmabuf.reset(x.fd);
       } else {
         exported = false;  // the driver cannot export: frames stay CPU-only
         log::debug(kLogV4l2, "{}: no dmabuf export ({})", path_, std::strerror(errno));
       }
     }
   }
-  buffers_ = new BufferSet(fd_.duplicate(), std::move(buffers));
+  buffers_ = V4l2BufferSet::create(fd_.duplicate(), std::move(buffers));
   pool_ = FramePool::create({mode_.format, mode_.width, mode_.height, req.count + 1, 1, false});
   buffers_->setStreaming(true);
   for (std::uint32_t i = 0; i < req.count; ++i) {
@@ -485,8 +412,7 @@ void V4l2Camera::stopStreaming(bool waitForShow) {
   if (waitForShow && !buffers_->waitForFrames(std::chrono::milliseconds(1000))) {
     log::warn(kLogV4l2, "{}: the show still holds {} frame(s) after 1 s", path_, buffers_->outstanding());
   }
-  buffers_->unref();  // unmaps now, or when the show gives the last frame back
-  buffers_ = nullptr;
+  buffers_.reset();  // unmaps now, or when the show gives the last frame back
   v4l2_requestbuffers req{};
   req.count = 0;
   req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -509,17 +435,17 @@ bool V4l2Camera::dequeue() {
   }
   if (b.flags & V4L2_BUF_FLAG_ERROR || b.bytesused == 0) {
     countDrop();
-    buffers_->queue(b.index);
+    (void)buffers_->queue(b.index);
     return true;
   }
   FrameRef frame = pool_->acquire();
   if (!frame) {
     countDrop();
-    buffers_->queue(b.index);
+    (void)buffers_->queue(b.index);
     return true;
   }
   const auto& buf = buffers_->buffers()[b.index];
-  auto* base = static_cast<std::uint8_t*>(buf.data);
+  auto* base = static_cast<std::uint8_t*>(buf.data());
   const FrameLayout layout = computeLayout(mode_.format, fmt_.width, fmt_.height, 1);
   frame->planeCount = layout.planeCount;
   // Planes follow each other in one buffer; rows are bytesperline apart (chroma rows of planar
@@ -549,9 +475,7 @@ bool V4l2Camera::dequeue() {
   // The SystemClock is CLOCK_MONOTONIC: the driver's timestamp is on the show's clock.
   frame->captureTime = monotonic && !clock().isManual() ? driver : clock().now();
   frame->pts = frame->captureTime;
-  frame->producerCookie = b.index;
-  buffers_->ref();
-  frame->setRelease(&BufferSet::release, buffers_);
+  buffers_->lend(*frame, b.index);
   deliver(std::move(frame));
   return true;
 }

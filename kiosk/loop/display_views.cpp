@@ -13,10 +13,11 @@ BASALT_LOG_CATEGORY(Views, "views");
 }  // namespace
 
 Result<std::unique_ptr<DisplayViews>> DisplayViews::create(const std::vector<ViewSpec>& specs,
-                                                           render::Renderer& renderer, render::Size output) {
+                                                           render::Renderer& renderer, render::Size output,
+                                                           const std::filesystem::path& savedCalibrations) {
   auto facets = render::FacetRenderer::create();
   if (!facets) return std::unexpected(facets.error());
-  std::unique_ptr<DisplayViews> d(new DisplayViews(renderer, std::move(*facets)));
+  std::unique_ptr<DisplayViews> d(new DisplayViews(renderer, std::move(*facets), savedCalibrations));
   std::size_t untiled = 0;
   for (const ViewSpec& s : specs) untiled += s.viewport ? 0U : 1U;
   const auto columns = static_cast<std::uint32_t>(std::ceil(std::sqrt(static_cast<double>(untiled))));
@@ -55,6 +56,7 @@ Result<std::unique_ptr<DisplayViews>> DisplayViews::create(const std::vector<Vie
         cave->settings.facet = s.facet;
       }
       v.cave = std::move(*cave);
+      d->readSavedCalibration(v);
       if (s.eyeSpacing) v.eyeSpacing = *s.eyeSpacing;
       if (!currentSet) d->current_ = d->views_.size(), currentSet = true;
     }
@@ -75,6 +77,41 @@ Result<std::unique_ptr<DisplayViews>> DisplayViews::create(const std::vector<Vie
     v.aids.emplace(std::move(*aids));
   }
   return d;
+}
+
+std::filesystem::path DisplayViews::savedCalibrationFile(const std::filesystem::path& folder, std::string_view name) {
+  std::string file(name);
+  for (char& c : file) {
+    const bool plain =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' || c == '-' || c == '_';
+    if (!plain) c = '_';
+  }
+  return folder / (file + ".cave");
+}
+
+void DisplayViews::readSavedCalibration(View& v) const {
+  if (savedCalibrations_.empty()) return;
+  const std::filesystem::path saved = savedCalibrationFile(savedCalibrations_, v.spec.name);
+  std::error_code ec;
+  const auto savedTime = std::filesystem::last_write_time(saved, ec);
+  if (ec) return;  // nothing saved yet
+  // The cave file edited after the calibration was saved (or a show put in place since) wins.
+  const auto caveTime = std::filesystem::last_write_time(v.spec.cave, ec);
+  if (!ec && caveTime > savedTime) {
+    log::warn(kLogViews, "view '{}': {} changed after the calibration saved in {}; playing the cave file's",
+              v.spec.name, v.spec.cave.string(), saved.string());
+    return;
+  }
+  const std::filesystem::path caveFile = v.cave.path;
+  auto read = formats::loadCave(saved, &v.cave);
+  if (!read) {
+    log::warn(kLogViews, "view '{}': the saved calibration cannot be used ({}); playing {}", v.spec.name,
+              read.error().describe(), v.spec.cave.string());
+    return;
+  }
+  v.cave = std::move(*read);
+  v.cave.path = caveFile;
+  log::info(kLogViews, "view '{}': calibration read from {}", v.spec.name, saved.string());
 }
 
 std::optional<std::size_t> DisplayViews::facetViewNamed(const std::string& of) const {
@@ -222,12 +259,18 @@ Result<std::string> DisplayViews::calibrate(std::string_view name, std::string_v
   log::info(kLogViews, "view '{}' calibrated: {}", v.spec.name, statements);
   if (save) {
     if (auto written = saveCalibration(*index); !written) return std::unexpected(written.error());
-    log::info(kLogViews, "view '{}': calibration saved to {}", v.spec.name, v.cave.path.string());
+    log::info(kLogViews, "view '{}': calibration saved to {}", v.spec.name, calibrationFile(*index).string());
   }
   const formats::CaveSettings& c = v.cave.settings;
   return fmt::format("view '{}': facet[{}] side[{}] Xscale[{}] Yscale[{}] Xskew[{}] Yskew[{}] Zrotation[{}]{}",
                      v.spec.name, c.facet, c.side, c.xScale, c.yScale, c.xSkew, c.ySkew, c.zRotation,
-                     save ? fmt::format(" (saved to {})", v.cave.path.string()) : std::string());
+                     save ? fmt::format(" (saved to {})", calibrationFile(*index).string()) : std::string());
+}
+
+std::filesystem::path DisplayViews::calibrationFile(std::size_t index) const {
+  if (index >= views_.size() || views_[index].spec.kind != ViewKind::kFacet) return {};
+  const View& v = views_[index];
+  return savedCalibrations_.empty() ? v.cave.path : savedCalibrationFile(savedCalibrations_, v.spec.name);
 }
 
 Result<void> DisplayViews::saveCalibration(std::size_t index) const {
@@ -235,7 +278,11 @@ Result<void> DisplayViews::saveCalibration(std::size_t index) const {
     return fail(Errc::kInvalidArgument, fmt::format("view {} is not a facet view", index));
   }
   const View& v = views_[index];
-  return formats::writeCave(v.cave.path, v.cave.settings);
+  if (savedCalibrations_.empty()) return formats::writeCave(v.cave.path, v.cave.settings);
+  // A cave file of its own, complete: it names the show's geometry where it is.
+  formats::CaveSettings settings = v.cave.settings;
+  if (v.cave.geometry) settings.model = std::filesystem::absolute(v.cave.geometry->path).lexically_normal().string();
+  return formats::writeCave(calibrationFile(index), settings);
 }
 
 const runtime::CaveAids* DisplayViews::aids(std::size_t index) const {

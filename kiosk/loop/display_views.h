@@ -7,8 +7,10 @@
 /// visual aids of a facet view (§4.4.6: the display seen from outside with the current facet,
 /// its normal, the viewer and the computed vectors, over the world).
 /// Holds each facet view's calibration, adjustable live with the thesis' keys (Appendix B) and
-/// saved back to its `.cave` file.
+/// saved back to its `.cave` file, or, where the show's folder is not the node's to write (a
+/// service), to a cave file of its own in a folder of saved calibrations, read back at start.
 
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -40,8 +42,16 @@ class DisplayViews final : public ViewDrawer {
  public:
   /// \brief Loads each facet view's cave file and checks its facet; views without a viewport
   /// are tiled over the output (a grid, left to right, top to bottom). Needs the GL context.
-  [[nodiscard]] static Result<std::unique_ptr<DisplayViews>> create(const std::vector<ViewSpec>& views,
-                                                                    render::Renderer& renderer, render::Size output);
+  /// With `savedCalibrations` (a folder, such as the service's state folder), calibrations are
+  /// saved there, one cave file per view (savedCalibrationFile), and a view whose saved file is
+  /// newer than the show's cave file starts from it; empty: they are saved to the show's cave file.
+  [[nodiscard]] static Result<std::unique_ptr<DisplayViews>> create(
+      const std::vector<ViewSpec>& views, render::Renderer& renderer, render::Size output,
+      const std::filesystem::path& savedCalibrations = {});
+  /// \brief Where view `name`'s calibration is saved in `folder`: `NAME.cave`, with characters
+  /// other than letters, digits, '.', '-' and '_' turned into '_'.
+  [[nodiscard]] static std::filesystem::path savedCalibrationFile(const std::filesystem::path& folder,
+                                                                  std::string_view name);
 
   void drawViews(const runtime::Show& show, render::Size output,
                  const std::function<void(runtime::ViewTransforms&)>& adjust) override;
@@ -56,12 +66,16 @@ class DisplayViews final : public ViewDrawer {
   /// \brief Calibration as text, for the control server: `statements` in the cave file's syntax
   /// (`facet`, `side`, `Xscale`, `Yscale`, `Xskew`, `Yskew`, `Zrotation`; no `model`), one per
   /// line or separated by ';', applied to the facet view named `name` ("" = the first) as one
-  /// change: a bad statement changes nothing. With `save`, written back to its cave file.
+  /// change: a bad statement changes nothing. With `save`, written back (saveCalibration).
   /// Returns the view's settings afterwards, in the cave file's bracket form on one line. Errors: kNotFound (no such
   /// facet view), kInvalidArgument or kParse (a bad statement), kIo (the file could not be written).
   [[nodiscard]] Result<std::string> calibrate(std::string_view name, std::string_view statements, bool save);
-  /// \brief Writes view `index`'s calibration back to its cave file.
+  /// \brief Writes view `index`'s calibration back to its cave file, or to its own file in the
+  /// folder of saved calibrations when there is one (a whole cave file naming the geometry by its
+  /// absolute path, so that `basalt check` reads it alone).
   [[nodiscard]] Result<void> saveCalibration(std::size_t index) const;
+  /// \brief The file view `index`'s calibration is saved to (empty for other views).
+  [[nodiscard]] std::filesystem::path calibrationFile(std::size_t index) const;
   /// \brief The projection drawn last for view `index` (facet views).
   [[nodiscard]] const runtime::FacetProjection* lastProjection(std::size_t index) const;
   /// \brief The visual aids drawn last by view `index` (aids views).
@@ -84,11 +98,15 @@ class DisplayViews final : public ViewDrawer {
   /// The facet input of facet view `v` this frame (no aspect: the caller sets it).
   static runtime::FacetViewInput facetInput(const View& v, const runtime::Show& show);
   void drawAids(View& v, const runtime::Show& show, const std::function<void(runtime::ViewTransforms&)>& adjust);
-  DisplayViews(render::Renderer& renderer, std::unique_ptr<render::FacetRenderer> facets)
-      : renderer_(renderer), facets_(std::move(facets)) {}
+  /// Starts facet view `v` from its saved calibration when there is one newer than its cave file.
+  void readSavedCalibration(View& v) const;
+  DisplayViews(render::Renderer& renderer, std::unique_ptr<render::FacetRenderer> facets,
+               std::filesystem::path savedCalibrations)
+      : renderer_(renderer), facets_(std::move(facets)), savedCalibrations_(std::move(savedCalibrations)) {}
 
   render::Renderer& renderer_;
   std::unique_ptr<render::FacetRenderer> facets_;
+  std::filesystem::path savedCalibrations_;  ///< empty: calibrations are saved to the cave files
   std::vector<View> views_;
   std::size_t current_ = 0;
   runtime::CaveKeys keys_;

@@ -17,15 +17,33 @@ FrameLoop::FrameLoop(const FrameLoopConfig& config, const Clock& clock, ManualCl
                      runtime::Show& show, render::Output& output, render::Renderer& renderer)
     : config_(config), clock_(clock), manual_(manual), loop_(loop), show_(show), output_(output), renderer_(renderer) {}
 
-void FrameLoop::applyInput(Nanos until) {
-  if (!events_) return;
-  events_->drainWhile([until](const Event& e) { return e.time <= until; },
-                      [this](Event e) {
-                        if (bindings_) bindings_->apply(e, show_);
-                      });
-  // Continuous input (shuttle rings held off-centre) moves the show by the time since the last frame.
-  if (bindings_ && lastInput_.count() >= 0 && until > lastInput_) bindings_->advance(until - lastInput_, show_);
-  lastInput_ = until;
+void takeDueInput(BoundedQueue<Event>& events, Nanos until, std::vector<Event>& batch, std::vector<Event>& later) {
+  batch.clear();
+  std::size_t kept = 0;
+  for (const Event& e : later) {
+    if (e.time <= until) {
+      batch.push_back(e);
+    } else {
+      later[kept++] = e;
+    }
+  }
+  later.resize(kept);
+  events.drainWhile([](const Event&) { return true; },
+                    [&](Event e) {
+                      if (e.time <= until) {
+                        batch.push_back(e);
+                      } else {
+                        later.push_back(e);
+                      }
+                    });
+  // Insertion sort: stable (one device's events keep their order when they share a time), no
+  // allocation, and about one pass for a batch that is nearly in order already.
+  for (std::size_t i = 1; i < batch.size(); ++i) {
+    const Event e = batch[i];
+    std::size_t j = i;
+    for (; j > 0 && batch[j - 1].time > e.time; --j) batch[j] = batch[j - 1];
+    batch[j] = e;
+  }
 }
 
 Result<void> FrameLoop::renderFrame(FrameContext& context) {
@@ -134,7 +152,6 @@ Result<FrameLoopStats> FrameLoop::run() {
     }
     const bool last =
         stopRequested_ || participantWantsStop() || (config_.maxFrames >= 0 && drawn + 1 == config_.maxFrames);
-    applyInput(due);
     FrameContext context{frame, due, last};
     if (auto r = renderFrame(context); !r) return std::unexpected(r.error());
     if (drawn == 0) stats.firstFrameSeconds = toSeconds(wall.now() - wallStart);

@@ -11,7 +11,6 @@
 
 #include "render/output.h"
 #include "render/renderer.h"
-#include "runtime/bindings.h"
 #include "runtime/bounded_queue.h"
 #include "runtime/clock.h"
 #include "runtime/event.h"
@@ -21,6 +20,14 @@
 namespace basalt::kiosk {
 
 class ViewDrawer;  // kiosk/loop/display_views.h
+
+/// \brief Takes every event due by `until` into `batch` (emptied first), in the order of their
+/// times: the devices' threads push in the order they run, not in the order of their events, so
+/// one device's event that is not due yet must not hold back another's that is. Those not due
+/// wait in `later` (the caller keeps it from frame to frame) and come first when they are.
+/// Allocates only when a vector must grow. The one way input leaves a run's queue: the show
+/// director applies what it returns.
+void takeDueInput(BoundedQueue<Event>& events, Nanos until, std::vector<Event>& batch, std::vector<Event>& later);
 
 /// \brief What a participant learns about the frame being made.
 struct FrameContext {
@@ -102,8 +109,9 @@ struct FrameLoopStats {
 
 /// \brief Runs frames until the frame budget is spent or stop is requested.
 ///
-/// Threading: everything runs on the calling thread. Devices feed `events` from their threads
-/// and wake `loop`; the loop never waits on a device.
+/// Threading: everything runs on the calling thread. Devices feed the run's event queue from
+/// their threads and wake `loop`; the show director drains it (takeDueInput) in its beforeDraw;
+/// the loop never waits on a device.
 class FrameLoop {
  public:
   /// \brief Called after a frame is drawn and before it is presented: snapshots, recording,
@@ -118,17 +126,12 @@ class FrameLoop {
   void setFrameHook(FrameHook hook) { hook_ = std::move(hook); }
   /// \brief Adds a participant (borrowed: it must outlive the loop's run()).
   void addParticipant(FrameParticipant& participant) { participants_.push_back(&participant); }
-  /// \brief The queue input events arrive in (owned by the caller).
   /// \brief Draws the frame's views instead of the one plain view (a manifest's `[[views]]`:
   /// facets, eyes, tiles); borrowed, null for the plain view.
   void setViewDrawer(ViewDrawer* drawer) { viewDrawer_ = drawer; }
   /// \brief Takes frame numbers and times from `gate` (a frame-locked follower); borrowed, null
   /// to pace on the clock. `maxFrames` then counts the frames drawn.
   void setGate(FrameGate* gate) { gate_ = gate; }
-  void setEvents(BoundedQueue<Event>* events, runtime::Bindings* bindings) {
-    events_ = events;
-    bindings_ = bindings;
-  }
 
   /// \brief Runs until done; the error is the first failure of drawing, presenting or a hook.
   Result<FrameLoopStats> run();
@@ -136,7 +139,6 @@ class FrameLoop {
   void requestStop() { stopRequested_ = true; }
 
  private:
-  void applyInput(Nanos until);
   /// Waits, serving the event loop, until the output can take the next frame (paced outputs).
   Result<void> waitForOutput();
   /// Draws one frame; `context.last` becomes true when a participant asks to stop during it.
@@ -152,11 +154,8 @@ class FrameLoop {
   render::Renderer& renderer_;
   FrameHook hook_;
   std::vector<FrameParticipant*> participants_;
-  BoundedQueue<Event>* events_ = nullptr;
-  runtime::Bindings* bindings_ = nullptr;  // stateful: dial speeds and shuttles
   ViewDrawer* viewDrawer_ = nullptr;
   FrameGate* gate_ = nullptr;
-  Nanos lastInput_{-1};
   bool stopRequested_ = false;
 };
 

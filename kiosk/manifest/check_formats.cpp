@@ -101,27 +101,18 @@ Findings findCave(const std::filesystem::path& file) {
   return f;
 }
 
-CheckResult print(const Findings& f) {
-  CheckResult result;
-  for (const Diagnostic& d : f.problems) {
-    // As `basalt check SCRIPT.mdl` prints: "file:line: error: ...".
-    const std::string_view severity = d.severity == Severity::kError     ? "error"
-                                      : d.severity == Severity::kWarning ? "warning"
-                                                                         : "note";
-    fmt::print("{}{}: {}: {}\n", d.file.string(), d.line > 0 ? fmt::format(":{}", d.line) : std::string(), severity,
-               d.message);
-    if (d.severity == Severity::kError) ++result.errors;
-    if (d.severity == Severity::kWarning) ++result.warnings;
-  }
-  result.items = f.items;
-  return result;
+CheckResult result(Findings f) {
+  CheckResult r;
+  r.diagnostics = std::move(f.problems);
+  r.items = f.items;
+  return r;
 }
 
 }  // namespace
 
-CheckResult checkSceneFile(const std::filesystem::path& file) { return print(findScene(file)); }
-CheckResult checkModelFile(const std::filesystem::path& file) { return print(findModel(file)); }
-CheckResult checkCaveFile(const std::filesystem::path& file) { return print(findCave(file)); }
+CheckResult checkSceneFile(const std::filesystem::path& file) { return result(findScene(file)); }
+CheckResult checkModelFile(const std::filesystem::path& file) { return result(findModel(file)); }
+CheckResult checkCaveFile(const std::filesystem::path& file) { return result(findCave(file)); }
 
 std::vector<Diagnostic> checkSceneContent(const std::filesystem::path& file) { return findScene(file).problems; }
 std::vector<Diagnostic> checkModelContent(const std::filesystem::path& file) { return findModel(file).problems; }

@@ -12,7 +12,7 @@
 
 namespace basalt::kiosk {
 
-/// \brief `basalt check FILE`: prints each problem as `file:line: error|warning: ...`.
+/// \brief `basalt check FILE`: every problem of the file, as diagnostics.
 CheckResult checkSceneFile(const std::filesystem::path& file);
 CheckResult checkModelFile(const std::filesystem::path& file);
 CheckResult checkCaveFile(const std::filesystem::path& file);

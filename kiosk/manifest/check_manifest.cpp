@@ -1,7 +1,5 @@
 // `basalt check show.toml`: the manifest checker. Reads the manifest as `basalt run` does, with
-// every referenced file's own checker, and prints all problems, then one summary line.
-
-#include <cstdio>
+// every referenced file's own checker, and returns all problems and its verdict on the show.
 
 #include <fmt/format.h>
 #include <fmt/std.h>
@@ -11,26 +9,28 @@
 
 namespace basalt::kiosk {
 
-int checkManifestFile(const std::filesystem::path& file, std::FILE* out) {
+CheckResult checkManifestFile(const std::filesystem::path& file) {
   Diagnostics diagnostics;
   ReadOptions options;
   options.fileCheckers = &contentCheckers();
   const auto manifest = readManifest(file, diagnostics, options);
-  fmt::print(out, "{}", diagnostics.format());
-  const std::size_t errors = diagnostics.errorCount();
-  if (errors > 0 || !manifest) {
-    fmt::print(out, "{}: {} problem{}; the show will not start until {} fixed\n", file.string(), errors,
-               errors == 1 ? "" : "s", errors == 1 ? "it is" : "they are");
-    std::fflush(out);
-    return 1;
+  CheckResult result;
+  result.diagnostics = diagnostics.items();
+  result.items = 1;
+  if (!manifest && result.errors() == 0) {
+    // Not expected (the reader says why it gives up), but a manifest that is not read is never "ok".
+    result.diagnostics.push_back({Severity::kError, file, 0, "the manifest could not be read"});
   }
-  fmt::print(
-      out, "{}: ok: '{}' plays {} with {} device{}, {} media, {} binding{}\n", file.string(), manifest->name,
+  if (const std::size_t errors = result.errors(); errors > 0 || !manifest) {
+    result.verdict = fmt::format("its last good copy plays until {} fixed", errors == 1 ? "it is" : "they are");
+    return result;
+  }
+  result.verdict = fmt::format(
+      "ok: '{}' plays {} with {} device{}, {} media, {} binding{}", manifest->name,
       manifest->entry.kind == EntryKind::kBuiltinDefault ? std::string("the default show") : manifest->entry.text,
       manifest->devices.size(), manifest->devices.size() == 1 ? "" : "s", manifest->media.size(),
       manifest->bindings.size(), manifest->bindings.size() == 1 ? "" : "s");
-  std::fflush(out);
-  return 0;
+  return result;
 }
 
 }  // namespace basalt::kiosk

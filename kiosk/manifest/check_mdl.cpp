@@ -54,8 +54,7 @@ CheckResult checkMdl(const std::filesystem::path& file) {
   CheckResult result;
   auto interpreter = script::Interpreter::load(file);
   if (!interpreter) {
-    fmt::print("{}: error: {}\n", file.string(), interpreter.error().message());
-    result.errors = 1;
+    result.diagnostics.push_back({Severity::kError, file, 0, interpreter.error().message()});
     return result;
   }
   const script::Program& program = interpreter->program();
@@ -66,9 +65,10 @@ CheckResult checkMdl(const std::filesystem::path& file) {
   all.insert(all.end(), more.begin(), more.end());
   script::sortByLine(all);
   for (const script::Diagnostic& d : all) {
-    fmt::print("{}:{}: {}: {}\n", d.file, d.line, script::severityName(d.severity), d.message);
-    if (d.severity == script::Severity::kError) ++result.errors;
-    if (d.severity == script::Severity::kWarning) ++result.warnings;
+    const Severity severity = d.severity == script::Severity::kError     ? Severity::kError
+                              : d.severity == script::Severity::kWarning ? Severity::kWarning
+                                                                         : Severity::kNote;
+    result.diagnostics.push_back({severity, d.file, static_cast<int>(d.line), d.message});
   }
   result.items = program.commandLines;
   return result;

@@ -18,7 +18,7 @@ namespace basalt::kiosk {
 std::vector<script::Diagnostic> checkScriptStatically(const script::Program& program,
                                                       const std::filesystem::path& folder);
 
-/// \brief Checks one script file and prints every problem as `file:line: error: ...`.
+/// \brief Checks one script file: every problem, as diagnostics.
 CheckResult checkMdl(const std::filesystem::path& file);
 
 }  // namespace basalt::kiosk

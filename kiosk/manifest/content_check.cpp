@@ -27,14 +27,8 @@ namespace {
 /// How long `basalt check` (and a reload's checks) give one movie file.
 constexpr std::chrono::seconds kMovieProbeTimeout{5};
 
-/// A show manifest: every section and every file it names (kiosk/manifest/check_manifest.cpp prints
-/// the problems and a summary line).
-CheckResult checkToml(const std::filesystem::path& file) {
-  CheckResult result;
-  result.errors = checkManifestFile(file, stdout) == 0 ? 0 : 1;
-  result.items = 1;
-  return result;
-}
+/// A show manifest: every section and every file it names (kiosk/manifest/check_manifest.cpp).
+CheckResult checkToml(const std::filesystem::path& file) { return checkManifestFile(file); }
 
 // One line per kind of file; the checker lives in its own file.
 constexpr FileChecker kCheckers[] = {
@@ -130,6 +124,30 @@ std::vector<Diagnostic> checkTraceContent(const std::filesystem::path& folder) {
 }
 
 }  // namespace
+
+std::size_t CheckResult::errors() const {
+  return static_cast<std::size_t>(std::count_if(diagnostics.begin(), diagnostics.end(),
+                                                [](const Diagnostic& d) { return d.severity == Severity::kError; }));
+}
+
+std::size_t CheckResult::warnings() const {
+  return static_cast<std::size_t>(std::count_if(diagnostics.begin(), diagnostics.end(),
+                                                [](const Diagnostic& d) { return d.severity == Severity::kWarning; }));
+}
+
+std::string_view severityName(Severity severity) {
+  switch (severity) {
+    case Severity::kError: return "error";
+    case Severity::kWarning: return "warning";
+    case Severity::kNote: return "note";
+  }
+  return "error";
+}
+
+std::string formatCheckDiagnostic(const Diagnostic& d) {
+  return fmt::format("{}{}: {}: {}", d.file.string(), d.line > 0 ? fmt::format(":{}", d.line) : std::string(),
+                     severityName(d.severity), d.message);
+}
 
 std::span<const FileChecker> fileCheckers() { return kCheckers; }
 

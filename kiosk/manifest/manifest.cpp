@@ -296,29 +296,112 @@ Result<std::filesystem::path> confinePath(const std::filesystem::path& folder, s
 
 namespace {
 
-/// Where a manifest has a non-ASCII character that TOML does not allow, or that the TOML reader
-/// Basalt builds with (toml++ 3.3) cannot look at safely: outside quotes and comments (invalid
-/// TOML, and toml++'s whitespace test has undefined behaviour for most such characters), right
-/// after a backslash in a multi-line basic string, or first after a line-ending backslash.
-struct NonAsciiSpot {
+/// A place in a manifest that toml++ must not be given, with what is wrong there.
+struct TextProblem {
   int line = 0;
-  int column = 0;
+  int column = 0;  // in characters, 1-based
+  std::string what;
 };
 
-std::optional<NonAsciiSpot> misplacedNonAscii(std::string_view text) {
+/// Checks that `text` is UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing above
+/// U+10FFFF, no sequence cut short). Returns the first bad byte's place.
+std::optional<TextProblem> invalidUtf8(std::string_view text) {
+  int line = 1;
+  int column = 1;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    if (b < 0x80) {
+      if (b == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+      ++i;
+      continue;
+    }
+    // The sequence's length and the range its second byte must fall in (the narrower ranges
+    // rule out overlong forms, surrogates and code points above U+10FFFF).
+    std::size_t length = 0;
+    unsigned char low = 0x80;
+    unsigned char high = 0xBF;
+    if (b >= 0xC2 && b <= 0xDF) {
+      length = 2;
+    } else if (b >= 0xE0 && b <= 0xEF) {
+      length = 3;
+      if (b == 0xE0) low = 0xA0;
+      if (b == 0xED) high = 0x9F;
+    } else if (b >= 0xF0 && b <= 0xF4) {
+      length = 4;
+      if (b == 0xF0) low = 0x90;
+      if (b == 0xF4) high = 0x8F;
+    } else {
+      return TextProblem{line, column,
+                         fmt::format("byte 0x{:02X} cannot start a UTF-8 character{}", b,
+                                     b >= 0x80 && b <= 0xBF ? " (a continuation byte without a lead byte)" : "")};
+    }
+    for (std::size_t k = 1; k < length; ++k) {
+      if (i + k >= text.size()) {
+        return TextProblem{
+            line, column,
+            fmt::format("the file ends inside a UTF-8 character (byte 0x{:02X} needs {} more)", b, length - k)};
+      }
+      const auto c = static_cast<unsigned char>(text[i + k]);
+      const unsigned char lo = k == 1 ? low : 0x80;
+      const unsigned char hi = k == 1 ? high : 0xBF;
+      if (c < lo || c > hi) {
+        return TextProblem{line, column,
+                           fmt::format("byte 0x{:02X} after 0x{:02X} is not part of a valid UTF-8 character", c, b)};
+      }
+    }
+    i += length;
+    ++column;
+  }
+  return std::nullopt;
+}
+
+/// Where a manifest has a non-ASCII character that TOML does not allow, or that the TOML reader
+/// Basalt builds with (toml++ 3.3) cannot look at safely. toml++ 3.3's test for non-ASCII
+/// whitespace reaches `unreachable` (undefined behaviour) for U+00A1..U+0499 (Latin-1, Greek,
+/// Cyrillic), U+2C5E..U+3057 and U+FB26..U+FEFE, and toml++ applies that test to every
+/// character it reads outside a string or comment: while skipping whitespace, and while reading
+/// a bare key, number, date or boolean up to its end. So such characters may reach toml++ only
+/// where it reads them as the content of a string or a comment:
+/// - a quote starts a string only where TOML allows one (a key at the start of a line, after
+///   `[`, `{`, `.` in a key, `,` or `=`); elsewhere (`8'...`, `'a''b'`) toml++ reads it as part
+///   of a token or refuses it, and what follows is outside any string;
+/// - inside a multi-line basic string, not right after a backslash, nor first after a
+///   line-ending backslash (toml++ tests those for whitespace).
+std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
   enum class In { kCode, kComment, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
+  enum class Open { kHeader, kArray, kInlineTable };
   In in = In::kCode;
   int line = 1;
   std::size_t lineStart = 0;
+  std::vector<Open> open;  // brackets and braces open in code, innermost last
+  bool keyContext = true;  // a key may come next (rather than a value)
+  char previous = '\n';    // the last character of code that is not a space, tab or comment
   const auto spot = [&](std::size_t at) {
     int column = 1;
     for (std::size_t i = lineStart; i < at; ++i) column += (static_cast<unsigned char>(text[i]) & 0xC0) != 0x80;
-    return NonAsciiSpot{line, column};
+    return TextProblem{line, column, "a non-ASCII character outside quotes or a comment"};
   };
   const auto quotes = [&](std::size_t at, char q) {
     std::size_t n = 0;
     while (at + n < text.size() && text[at + n] == q) ++n;
     return n;
+  };
+  const auto stringMayStart = [&] {
+    switch (previous) {
+      case '=':
+      case ',':
+      case '{':
+      case '[': return true;        // '[': a table header's key or an array's first value
+      case '.': return keyContext;  // a dotted key; after a digit, a number goes on
+      case '\n': return true;       // a key at the start of a line
+      default: return false;
+    }
   };
   std::size_t i = text.starts_with("\xEF\xBB\xBF") ? 3 : 0;
   while (i < text.size()) {
@@ -327,21 +410,54 @@ std::optional<NonAsciiSpot> misplacedNonAscii(std::string_view text) {
     if (c == '\n') {
       ++line;
       lineStart = i + 1;
-      if (in != In::kMultiBasic && in != In::kMultiLiteral) in = In::kCode;
+      if (in != In::kMultiBasic && in != In::kMultiLiteral) {
+        in = In::kCode;
+        // A new line at the top level starts a key; inside an array, values go on.
+        if (open.empty() || open.back() != Open::kArray) {
+          open.clear();
+          keyContext = true;
+          previous = '\n';
+        }
+      }
       ++i;
       continue;
     }
     switch (in) {
       case In::kCode:
         if (high) return spot(i);
+        if (c == ' ' || c == '\t' || c == '\r') break;
         if (c == '#') {
           in = In::kComment;
-        } else if (c == '"' || c == '\'') {
+          break;
+        }
+        if (c == '"' || c == '\'') {
+          if (!stringMayStart()) {
+            previous = c;  // part of a bad token: what follows is code
+            break;
+          }
           const bool multi = quotes(i, c) >= 3;
           in = c == '"' ? (multi ? In::kMultiBasic : In::kBasic) : (multi ? In::kMultiLiteral : In::kLiteral);
+          previous = c;
           i += multi ? 3 : 1;
           continue;
         }
+        if (c == '[') {
+          // `[` at the start of a line opens a table header, and `[[` an array-of-tables header.
+          const bool header = keyContext && (open.empty() || (open.back() == Open::kHeader && previous == '['));
+          open.push_back(header ? Open::kHeader : Open::kArray);
+          keyContext = open.back() == Open::kHeader;
+        } else if (c == '{') {
+          open.push_back(Open::kInlineTable);
+          keyContext = true;
+        } else if (c == ']' || c == '}') {
+          if (!open.empty()) open.pop_back();
+          keyContext = false;
+        } else if (c == '=') {
+          keyContext = false;
+        } else if (c == ',') {
+          keyContext = !open.empty() && open.back() == Open::kInlineTable;
+        }
+        previous = c;
         break;
       case In::kComment: break;
       case In::kBasic:
@@ -478,6 +594,13 @@ class Reader {
       diags_.error(
           shown_, 0,
           fmt::format("the manifest is {} bytes; a show.toml is at most {} bytes", text.size(), kMaxManifestBytes));
+      return std::nullopt;
+    }
+    // toml++ is given only valid UTF-8, and non-ASCII characters only where it reads them as
+    // string or comment content (see misplacedNonAscii).
+    if (const auto bad = invalidUtf8(text)) {
+      diags_.error(shown_, bad->line,
+                   fmt::format("not valid UTF-8 at column {}: {}; save the manifest as UTF-8", bad->column, bad->what));
       return std::nullopt;
     }
     if (const auto bad = misplacedNonAscii(text)) {

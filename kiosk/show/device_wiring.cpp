@@ -48,27 +48,40 @@ std::vector<std::unique_ptr<devices::DeviceProvider>> allProviders(const std::ve
   return out;
 }
 
-DeviceWiring::DeviceWiring(const Clock& clock, std::function<void()> wake)
-    : clock_(clock), events_(4096, std::move(wake)), manager_(clock, events_) {}
+namespace {
+
+devices::DeviceManager::Config numberedFrom(DeviceId firstId) {
+  devices::DeviceManager::Config config;
+  config.firstId = firstId;
+  return config;
+}
+
+}  // namespace
+
+DeviceWiring::DeviceWiring(const Clock& clock, BoundedQueue<Event>& events, DeviceId firstId)
+    : clock_(clock), events_(events), manager_(clock, events_, numberedFrom(firstId)) {}
 
 DeviceWiring::~DeviceWiring() { stop(); }
 
-Result<void> DeviceWiring::addReplay(const std::filesystem::path& path, bool loop,
-                                     sim::TraceVideoReaderFactory videoReader) {
+Result<std::vector<DeviceId>> DeviceWiring::addReplay(const std::filesystem::path& path, bool loop,
+                                                      sim::TraceVideoReaderFactory videoReader) {
   auto provider = std::make_unique<sim::ReplayProvider>(std::move(videoReader));
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
-    if (auto r = provider->addTrace(path); !r) return r;
+    if (auto r = provider->addTrace(path); !r) return std::unexpected(r.error());
   } else if (auto r = provider->addHidRecording(path); !r) {
-    return r;
+    return std::unexpected(r.error());
   }
   auto requests = provider->requests();
   manager_.addProvider(std::move(provider));
+  std::vector<DeviceId> ids;
   for (auto& r : requests) {
     r.options["loop"] = loop ? "true" : "false";
-    if (auto id = manager_.request(r); !id) return std::unexpected(id.error());
+    auto id = manager_.request(r);
+    if (!id) return std::unexpected(id.error());
+    ids.push_back(*id);
   }
-  return {};
+  return ids;
 }
 
 void DeviceWiring::start(bool manualClock) {

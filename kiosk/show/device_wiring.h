@@ -1,9 +1,11 @@
 #pragma once
 
 /// \file
-/// \brief Wiring devices into a run: the backends (providers), the DeviceManager, udev hotplug,
-/// and a FrameParticipant that steps the manager on the frame loop's thread when the show runs
-/// on a ManualClock (on the SystemClock the manager runs on its own thread).
+/// \brief Wiring devices into a run beside its show's: the backends (providers), a DeviceManager
+/// that pushes into the run's one event queue, udev hotplug, and a FrameParticipant that steps
+/// the manager on the frame loop's thread when the show runs on a ManualClock (on the
+/// SystemClock the manager runs on its own thread). `basalt run --replay` (whose events the show
+/// director applies with the show's own), `basalt record` and the benches use it.
 
 #include <filesystem>
 #include <memory>
@@ -29,20 +31,26 @@ namespace basalt::kiosk {
 /// \brief Every real backend (hid, serial, v4l2, libcamera) and the synthetic one.
 std::vector<std::unique_ptr<devices::DeviceProvider>> allProviders(const std::vector<std::string>& serialPorts = {});
 
-/// \brief The devices of one run.
+/// \brief The first id of the devices a run adds beside its show's: the show director's manager
+/// numbers the show's from 1, and both push into the run's one queue.
+inline constexpr DeviceId kReplayFirstId = 0x10000;
+
+/// \brief The devices of one run beside its show's.
 class DeviceWiring {
  public:
-  /// `wake` is called when an event arrives (EventLoop::wake for a real-time run).
-  DeviceWiring(const Clock& clock, std::function<void()> wake);
+  /// Events go into `events` (the run's queue, which wakes the loop; borrowed, it outlives the
+  /// wiring), tagged with ids from `firstId` up.
+  DeviceWiring(const Clock& clock, BoundedQueue<Event>& events, DeviceId firstId = 1);
   ~DeviceWiring();
 
   [[nodiscard]] BoundedQueue<Event>& events() { return events_; }
   [[nodiscard]] devices::DeviceManager& manager() { return manager_; }
 
   /// \brief Replays every device of a trace folder or an hid-recorder file, by its recorded name.
-  /// `videoReader` reads trace videos other than .bvraw (media's Matroska reader).
-  [[nodiscard]] Result<void> addReplay(const std::filesystem::path& path, bool loop,
-                                       sim::TraceVideoReaderFactory videoReader = {});
+  /// `videoReader` reads trace videos other than .bvraw (media's Matroska reader). Returns the
+  /// ids their events carry.
+  [[nodiscard]] Result<std::vector<DeviceId>> addReplay(const std::filesystem::path& path, bool loop,
+                                                        sim::TraceVideoReaderFactory videoReader = {});
   /// \brief Starts: on a manual clock the participant steps the manager each frame; otherwise a
   /// thread does, with udev hotplug when udev is there.
   void start(bool manualClock);
@@ -62,7 +70,7 @@ class DeviceWiring {
   };
 
   const Clock& clock_;
-  BoundedQueue<Event> events_;
+  BoundedQueue<Event>& events_;
   devices::DeviceManager manager_;
   std::unique_ptr<devices::UdevMonitor> udev_;
   Stepper participant_{*this};

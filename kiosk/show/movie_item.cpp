@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "media/frame_picker.h"
 #include "media/movie_player.h"
 #include "runtime/log.h"
 
@@ -23,8 +24,6 @@ namespace {
 
 /// How long the loader waits for a movie's first frame before calling it unplayable.
 constexpr std::chrono::seconds kLoadTimeout{10};
-/// How long a frame under a ManualClock waits for the decoder.
-constexpr std::chrono::seconds kFrameTimeout{10};
 
 /// The error, located at the manifest line that names the movie (the file it concerns, if any,
 /// kept in the message).
@@ -82,27 +81,14 @@ class MovieItem final : public ItemPlayer {
     }
     // Offline runs wait for the frame due; so does a frame-locked node on the system clock,
     // bounded, so that it draws the frame the others draw.
-    const std::chrono::milliseconds patience =
-        playback_.manualClock     ? std::chrono::duration_cast<std::chrono::milliseconds>(kFrameTimeout)
-        : playback_.timelineStart ? playback_.patience
-                                  : std::chrono::milliseconds(0);
-    FrameRef f;
-    if (playback_.timelineStart && leaderFrame_ >= 0) {
-      // A follower shows the leader's frame by its number, not by its own decoder's timestamps
-      // (which can add up a fraction of a millisecond apart from the leader's).
-      media::NumberedFrame pick = player_->frameNumbered(leaderFrame_, frame.time, patience);
-      f = std::move(pick.frame);
-      leaderResult_ = leaderFrameResultOf(pick.outcome);
-    } else {
-      if (patience.count() > 0) player_->waitForFrameDue(frame.time, patience);
-      f = player_->frameAt(frame.time);
-      if (f && playback_.timelineStart && patience.count() > 0) {
-        // The frame a seek onto the timeline brought was due when the item started; a node that
-        // waited for it takes the frame due now as well, as the others do in this frame.
-        player_->waitForFrameDue(frame.time, patience);
-        if (FrameRef newer = player_->frameAt(frame.time)) f = std::move(newer);
-      }
-    }
+    const bool locked = playback_.timelineStart.has_value();
+    media::PickedFrame pick = media::pickFrame(*player_, {.showTime = frame.time,
+                                                          .leaderFrame = locked ? leaderFrame_ : -1,
+                                                          .manualClock = playback_.manualClock,
+                                                          .patience = playback_.patience,
+                                                          .onGroupTimeline = locked});
+    FrameRef f = std::move(pick.frame);
+    leaderResult_ = pick.outcome;
     const media::MovieState state = player_->state();
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) return std::unexpected(failure());
     auto changed = texture_->update(f);
@@ -184,15 +170,6 @@ class MovieItem final : public ItemPlayer {
 };
 
 }  // namespace
-
-LeaderFrameResult leaderFrameResultOf(media::NumberedOutcome outcome) {
-  switch (outcome) {
-    case media::NumberedOutcome::kAgreed: return LeaderFrameResult::kAgreed;
-    case media::NumberedOutcome::kCorrected: return LeaderFrameResult::kCorrected;
-    case media::NumberedOutcome::kLate: return LeaderFrameResult::kLate;
-  }
-  return LeaderFrameResult::kNone;
-}
 
 render::PictureRect letterbox(double pictureWidth, double pictureHeight, render::Size output) {
   if (!(pictureWidth > 0) || !(pictureHeight > 0) || output.width == 0 || output.height == 0) return {};

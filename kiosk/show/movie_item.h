@@ -13,15 +13,7 @@
 #include "render/output.h"
 #include "render/stream_texture.h"
 
-namespace basalt::media {
-enum class NumberedOutcome : std::uint8_t;  // media/movie_player.h
-}
-
 namespace basalt::kiosk {
-
-/// \brief What a frame-locked follower's movie (item or stream) reports for a frame it showed by
-/// the leader's number (media::MoviePlayer::frameNumbered).
-[[nodiscard]] LeaderFrameResult leaderFrameResultOf(media::NumberedOutcome outcome);
 
 /// \brief Where a picture of `picture` pixels (already corrected for pixel aspect) sits on an
 /// output of `output` pixels: as large as fits, centred, black bars on the two other sides.

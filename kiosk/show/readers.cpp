@@ -88,6 +88,8 @@ class PreparedItem final : public ItemPlayer {
   bool uploaded_ = false;
 };
 
+}  // namespace
+
 Result<std::unique_ptr<ItemPlayer>> makeModelItem(const EntrySpec& entry, const Manifest& manifest) {
   auto model = formats::loadModel(entry.path);  // warnings are logged with file:line:column
   if (!model) return std::unexpected(model.error().at(entryWhere(entry, manifest)));
@@ -127,6 +129,8 @@ Result<std::unique_ptr<ItemPlayer>> makeSceneItem(const EntrySpec& entry, const 
   return std::make_unique<PreparedItem>(std::move(show), std::move(images));
 }
 
+namespace {
+
 /// A LAVA script: the interpreter steps to the next `draw` in each frame's beforeDraw.
 class ScriptItem final : public ItemPlayer {
  public:
@@ -165,6 +169,8 @@ class ScriptItem final : public ItemPlayer {
   bool ended_ = false;
 };
 
+}  // namespace
+
 Result<std::unique_ptr<ItemPlayer>> makeScriptItem(const EntrySpec& entry, const Manifest& manifest) {
   auto interpreter = script::Interpreter::load(entry.path);
   if (!interpreter) return std::unexpected(interpreter.error().at(entryWhere(entry, manifest)));
@@ -185,6 +191,8 @@ Result<std::unique_ptr<ItemPlayer>> makeScriptItem(const EntrySpec& entry, const
   PreparedContent content = prepareScriptContent(program, folder);
   return std::make_unique<ScriptItem>(std::move(*interpreter), std::move(content));
 }
+
+namespace {
 
 std::string_view trimmed(std::string_view s) {
   const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
@@ -236,13 +244,6 @@ Result<std::string> runControlCommand(std::string_view command, const CommandTar
   if (!errors.empty()) return fail(Errc::kInvalidArgument, errors);
   log::info(kLogItems, "control command run: {}", command);
   return notes.empty() ? fmt::format("ran: {}", command) : fmt::format("ran: {} ({})", command, notes);
-}
-
-void registerContentReaders() {
-  setItemFactory(EntryKind::kScript, makeScriptItem);
-  setItemFactory(EntryKind::kScene, makeSceneItem);
-  setItemFactory(EntryKind::kModel, makeModelItem);
-  setCommandRunner(runControlCommand);
 }
 
 }  // namespace basalt::kiosk

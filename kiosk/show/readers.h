@@ -1,9 +1,10 @@
 #pragma once
 
 /// \file
-/// \brief Plugs Basalt's content readers into the kiosk's seams (kiosk/show/show_items.h): LAVA
-/// scripts (.mdl), scenes (.sce) and models (.obj, .off) as show items, and the script
-/// interpreter as the control server's command runner.
+/// \brief Basalt's content readers as the kiosk's factories (ItemFactories in
+/// kiosk/show/show_items.h): LAVA scripts (.mdl), scenes (.sce) and models (.obj, .off) as show
+/// items, and the script interpreter as the control server's command runner. The program puts
+/// them into its ShowFactories where it starts (app/show_factories.cpp).
 
 #include <string>
 #include <string_view>
@@ -12,10 +13,15 @@
 
 namespace basalt::kiosk {
 
-/// \brief Registers the script, scene and model item factories and the command runner. Call
-/// once where the program starts, before the first show loads (runShow, checkMain, tests).
-/// Movies are not registered: a movie item still fails with a message that says so.
-void registerContentReaders();
+/// \brief The item factory for LAVA scripts (EntryKind::kScript): parses the script and reads
+/// ahead every model and image it loads, so that stepping it never waits for a disk.
+[[nodiscard]] Result<std::unique_ptr<ItemPlayer>> makeScriptItem(const EntrySpec& entry, const Manifest& manifest);
+
+/// \brief The item factory for scenes (EntryKind::kScene): the scene, its imports and images.
+[[nodiscard]] Result<std::unique_ptr<ItemPlayer>> makeSceneItem(const EntrySpec& entry, const Manifest& manifest);
+
+/// \brief The item factory for models (EntryKind::kModel): shown as LAVA shows a loaded object.
+[[nodiscard]] Result<std::unique_ptr<ItemPlayer>> makeModelItem(const EntrySpec& entry, const Manifest& manifest);
 
 /// \brief The control server's command runner: one line of LAVA script run on the target's
 /// Show. Returns what happened (the command and any notes) or why it could not run.

@@ -22,6 +22,7 @@
 
 #include "kiosk/show/show_host.h"
 #include "kiosk/show/stream_factories.h"
+#include "media/frame_picker.h"
 #include "media/image_io.h"
 #include "render/stream_texture.h"
 #include "runtime/log.h"
@@ -339,16 +340,13 @@ void ScriptPlayer::followLeader(std::chrono::milliseconds patience) {
 
 FrameRef ScriptPlayer::vcrFrame(Nanos showTime, bool manualClock) {
   const std::int64_t leader = std::exchange(leaderFrame_, -1);  // used up: the next frame brings its own
-  if (follower_ && leader >= 0) {
-    // The leader's frame by its number: two decoders' timestamps need not add up alike.
-    const std::chrono::milliseconds patience = manualClock ? std::chrono::milliseconds(10000) : patience_;
-    media::NumberedFrame pick = vcr_->frameNumbered(leader, showTime, patience);
-    if (pick.outcome == media::NumberedOutcome::kCorrected) ++movieCounts_.corrected;
-    if (pick.outcome == media::NumberedOutcome::kLate) ++movieCounts_.late;
-    return std::move(pick.frame);
-  }
-  if (manualClock) vcr_->waitForFrameDue(showTime, std::chrono::seconds(10));
-  return vcr_->frameAt(showTime);
+  media::PickedFrame pick = media::pickFrame(*vcr_, {.showTime = showTime,
+                                                     .leaderFrame = follower_ ? leader : -1,
+                                                     .manualClock = manualClock,
+                                                     .patience = patience_});
+  if (pick.outcome == media::FrameOutcome::kCorrected) ++movieCounts_.corrected;
+  if (pick.outcome == media::FrameOutcome::kLate) ++movieCounts_.late;
+  return std::move(pick.frame);
 }
 
 void ScriptPlayer::updateVideo(const FrameContext& frameContext, bool manualClock) {

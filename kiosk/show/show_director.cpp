@@ -24,80 +24,36 @@ BASALT_LOG_CATEGORY(Director, "kiosk");
 namespace {
 
 constexpr Nanos kSaveEvery = std::chrono::seconds(2);
-constexpr Nanos kMaxRetry = std::chrono::seconds(30);
 
 }  // namespace
 
-/// A dial box's open on the device thread; `result` is written before `done`.
-struct PendingOpen {
-  std::atomic<bool> done{false};
-  Result<void> result;
-};
-
-/// Opens dial boxes one after another on a thread of its own, so that a device enumeration or a
-/// serial port's reset wait never holds up a frame; it also closes the boxes of a replaced show
-/// whose open was still running. Tasks run in the order given; the thread finishes them all
-/// before it ends.
-class ShowDirector::DeviceThread {
- public:
-  DeviceThread() : thread_([this] { run(); }) {}
-  ~DeviceThread() {
-    {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-    }
-    wake_.notify_one();
-    thread_.join();
-  }
-  DeviceThread(const DeviceThread&) = delete;
-  DeviceThread& operator=(const DeviceThread&) = delete;
-
-  void post(std::function<void()> task) {
-    {
-      std::lock_guard lock(mutex_);
-      tasks_.push_back(std::move(task));
-    }
-    wake_.notify_one();
-  }
-
- private:
-  void run() {
-    for (;;) {
-      std::function<void()> task;
-      {
-        std::unique_lock lock(mutex_);
-        wake_.wait(lock, [this] { return stopping_ || !tasks_.empty(); });
-        if (tasks_.empty()) return;
-        task = std::move(tasks_.front());
-        tasks_.pop_front();
-      }
-      task();
-    }
-  }
-
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::deque<std::function<void()>> tasks_;  // guarded by mutex_
-  bool stopping_ = false;                    // guarded by mutex_
-  std::thread thread_;                       // last: starts once the rest is built
-};
-
-ShowDirector::ShowDirector(DirectorContext context) : context_(context) { context_.board.setShowClock(context_.clock); }
+ShowDirector::ShowDirector(DirectorContext context, ShowFactories factories)
+    : context_(context),
+      factories_(std::move(factories)),
+      devices_(std::make_unique<devices::DeviceManager>(context_.clock, context_.events)) {
+  context_.board.setShowClock(context_.clock);
+  input_.reserve(context_.events.capacity());
+  inputLater_.reserve(context_.events.capacity());
+}
 
 ShowDirector::~ShowDirector() {
   if (udev_) udev_->stop();
-  deviceThread_.reset();  // an open still running ends first; then every box is the frame loop's
+  devices_->stop();  // an open still running ends first; then every device is closed
   if (loader_.joinable()) loader_.join();
   if (textureLoader_.joinable()) textureLoader_.join();
-  if (show_) {
-    for (DeviceSlot& slot : show_->devices) {
-      if (slot.dialBox) slot.dialBox->close();
-    }
-  }
+  for (PendingRestart& r : restarts_)
+    r.reply->answer(503, fmt::format("'{}' was not restarted: the show stopped", r.name));
   if (policy_ && context_.state) {
     context_.state->save(policy_->resumePoint(context_.clock.now()));
     context_.state->flush();
   }
+}
+
+void ShowDirector::noteHotplug() { devices_->notifyHotplug({devices::HotplugEvent::Action::kAdded, {}, {}}); }
+
+void ShowDirector::setReplayInput(runtime::Bindings* bindings, std::vector<DeviceId> devices) {
+  replayBindings_ = bindings;
+  replayDevices_ = std::move(devices);
 }
 
 void ShowDirector::install(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume) {
@@ -110,26 +66,22 @@ void ShowDirector::install(std::unique_ptr<LoadedShow> show, Nanos now, const st
 }
 
 void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume) {
-  // The old show's devices stop; their queued events are stale.
   if (show_) {
-    for (DeviceSlot& slot : show_->devices) {
-      if (slot.dialBox && !slot.opening) slot.dialBox->close();  // an opening one: see below
-    }
     for (const LoadedTexture& t : show_->textures) context_.renderer.textures().remove(t.name);
   }
-  Event stale;
-  while (context_.events.pop(stale)) {
-  }
+  // The old show's devices go back to the manager, which closes them on its own thread (an open
+  // still running there ends first: the frame loop never waits for it). Their events still
+  // queued carry ids no slot has any more: they are dropped when they come due.
+  for (const std::string& name : requested_) devices_->withdraw(name);
+  requested_.clear();
   player_ = nullptr;
   itemKey_.clear();  // the new show's players are new: what the old item uploaded goes
   std::unique_ptr<LoadedShow> old = std::move(show_);
   show_ = std::move(show);
   reportedFailures_.clear();
   const WallTime wall = context_.clock.wallNow();
-  for (DeviceSlot& slot : show_->devices) {
-    slot.since = wall;
-    slot.nextAttempt = now;
-  }
+  for (DeviceSlot& slot : show_->devices) slot.since = wall;
+  requestDevices();
   for (LoadedTexture& t : show_->textures) {
     if (t.image) {
       if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
@@ -154,27 +106,49 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   applyProgramme(now);
   publishDevices();
   publishStreams();
-  if (old && deviceThread_) {
-    // Boxes whose open still runs belong to the device thread: it closes and drops them after.
-    auto orphans = std::make_shared<std::vector<std::unique_ptr<devices::DialBox>>>();
-    for (DeviceSlot& slot : old->devices) {
-      if (slot.opening && slot.dialBox) orphans->push_back(std::move(slot.dialBox));
-    }
-    if (!orphans->empty()) {
-      deviceThread_->post([orphans] {
-        for (auto& box : *orphans) box->close();
-        orphans->clear();
-      });
-    }
-  }
   watchHotplug();
-  old.reset();  // after the new show is on: its players and devices go now
+  // On the system clock devices open on the manager's thread, never the frame loop's.
+  if (!context_.clock.isManual()) devices_->start();
+  old.reset();  // after the new show is on: its players and streams go now
+}
+
+bool ShowDirector::cameraShown(const std::string& device) const {
+  return std::ranges::any_of(show_->textures, [&](const LoadedTexture& t) {
+    const MediaSpec* media = t.stream && !t.source.empty() ? show_->manifest.findMedia(t.source) : nullptr;
+    return media && media->kind == MediaKind::kCamera && media->device == device;
+  });
+}
+
+void ShowDirector::requestDevices() {
+  for (DeviceSlot& slot : show_->devices) {
+    if (!slot.unavailable.empty() || !slot.source.provider) continue;
+    const bool camera = slot.spec.kind == DeviceKind::kCamera;
+    // A camera opens only when a texture shows it (or the scripts' VCR asks for it).
+    if (camera && !cameraShown(slot.spec.name)) continue;
+    const std::string name = slot.spec.name;
+    auto id = devices_->request(std::move(slot.source.request), std::move(slot.source.provider), slot.source.upkeep);
+    // The scripts' VCR may hold the camera already: the show shares it.
+    if (!id && camera) id = devices_->share(name);
+    if (!id) {
+      slot.unavailable = id.error().message();
+      slot.message = slot.unavailable;
+      log::warn(kLogDirector, "device '{}': {}", name, slot.unavailable);
+      continue;
+    }
+    slot.id = *id;
+    requested_.push_back(name);
+  }
+  // Camera textures find their camera in the manager by name.
+  for (LoadedTexture& t : show_->textures) {
+    if (t.stream) t.stream->useDevices(*devices_);
+  }
 }
 
 void ShowDirector::watchHotplug() {
   if (udev_ || context_.clock.isManual()) return;
   const bool hardware = std::ranges::any_of(show_->devices, [](const DeviceSlot& slot) {
-    return slot.dialBox && (slot.spec.backend == DeviceBackend::kHid || slot.spec.backend == DeviceBackend::kSerial);
+    return slot.id != 0 && slot.spec.kind == DeviceKind::kDialBox &&
+           (slot.spec.backend == DeviceBackend::kHid || slot.spec.backend == DeviceBackend::kSerial);
   });
   if (!hardware) return;
   auto monitor = devices::UdevMonitor::create({"hidraw", "usb", "tty"});
@@ -184,9 +158,8 @@ void ShowDirector::watchHotplug() {
     return;
   }
   udev_ = std::move(*monitor);
-  udev_->start([this](const devices::HotplugEvent& e) {
-    if (e.action == devices::HotplugEvent::Action::kAdded) noteHotplug();
-  });
+  // An added node retries what is not live at once; a removed one loses the device on it.
+  udev_->start([this](const devices::HotplugEvent& e) { devices_->notifyHotplug(e); });
 }
 
 void ShowDirector::loadTexturesInBackground() {
@@ -248,7 +221,7 @@ void ShowDirector::requestReload() {
   const std::filesystem::path file = show_->manifest.file;
   loader_ = std::thread([this, file] {
     Diagnostics diagnostics;
-    auto loaded = readAndLoadShow(file, context_.clock, diagnostics);
+    auto loaded = readAndLoadShow(file, context_.clock, factories_, diagnostics);
     {
       std::lock_guard lock(reloadMutex_);
       reloadReady_ = true;
@@ -355,22 +328,19 @@ void ShowDirector::handleControls(const FrameContext& frame) {
                                [&](const DeviceSlot& s) { return s.spec.name == request.argument; });
         if (it == show_->devices.end()) {
           reply.answer(404, fmt::format("no device '{}' in this show", request.argument));
-        } else if (!it->dialBox) {
-          reply.answer(409, fmt::format("'{}' cannot be restarted: {}", request.argument, it->unavailable));
+        } else if (it->id == 0) {
+          reply.answer(
+              409, fmt::format("'{}' cannot be restarted: {}", request.argument,
+                               it->unavailable.empty() ? "no texture shows it, so it is not open" : it->unavailable));
         } else {
-          it->dialBox->close();
-          const auto id = static_cast<DeviceId>(it - show_->devices.begin() + 1);
-          auto opened = it->dialBox->open(id, context_.events);
-          it->backoff = std::chrono::seconds(1);
-          it->nextAttempt = now + it->backoff;
-          it->message = opened ? std::string() : opened.error().message();
-          log::info(kLogDirector, "device '{}' restarted by the control server: {}", request.argument,
-                    opened ? "live" : it->message);
-          // A device that is not there is not the server's fault: 503, and the director retries.
-          reply.answer(opened ? 200 : 503,
-                       opened ? fmt::format("'{}' restarted", request.argument)
-                              : fmt::format("'{}' could not be reopened: {}; it is retried every few seconds",
-                                            request.argument, opened.error().describe()));
+          // The manager closes and reopens it (on its thread on the system clock); the answer
+          // goes out when it is done.
+          std::uint32_t before = 0;
+          for (const devices::DeviceStatus& st : devices_->status()) {
+            if (st.id == it->id) before = st.restarts;
+          }
+          (void)devices_->restart(request.argument);
+          restarts_.push_back({request.argument, it->id, before, request.reply});
         }
         break;
       }
@@ -393,114 +363,132 @@ void ShowDirector::handleControls(const FrameContext& frame) {
 }
 
 void ShowDirector::serviceDevices(Nanos now) {
-  bool changed = false;
+  // Under a ManualClock a run repeats frame by frame: the manager opens, retries and services
+  // the devices here, before the frame's input is applied. On the system clock its own thread
+  // does, and the frame loop only hears what became of them.
+  if (context_.clock.isManual()) devices_->step(now);
+  mirrorDevices();
+}
+
+void ShowDirector::mirrorDevices() {
+  const std::uint64_t version = devices_->statusVersion();
+  if (version == devicesSeen_) return;
+  devicesSeen_ = version;
+  const std::vector<devices::DeviceStatus> all = devices_->status();
   const WallTime wall = context_.clock.wallNow();
-  if (hotplug_.exchange(false, std::memory_order_acq_rel)) {
-    // Something was plugged in: whatever is absent may be it.
-    for (DeviceSlot& slot : show_->devices) {
-      if (slot.dialBox && !slot.opening && slot.dialBox->state() != devices::DeviceState::kLive) {
-        slot.nextAttempt = now;
-        slot.backoff = std::chrono::seconds(1);
-      }
-    }
-  }
-  for (std::size_t i = 0; i < show_->devices.size(); ++i) {
-    DeviceSlot& slot = show_->devices[i];
-    if (!slot.dialBox) continue;
-    devices::DialBox& box = *slot.dialBox;
-    if (slot.opening) {
-      // The device thread owns the box until its open is done.
-      if (!slot.opening->done.load(std::memory_order_acquire)) continue;
-      const Result<void> opened = std::move(slot.opening->result);
-      slot.opening.reset();
-      noteOpen(slot, opened, now, changed);
-    } else if (box.state() != devices::DeviceState::kLive && now >= slot.nextAttempt) {
-      const auto id = static_cast<DeviceId>(i + 1);
-      if (context_.clock.isManual()) {
-        // Under a ManualClock a run repeats frame by frame: the open happens here.
-        const Result<void> opened = box.open(id, context_.events);
-        noteOpen(slot, opened, now, changed);
-      } else {
-        // Enumerating devices and opening one can take long (a serial port's reset wait):
-        // never on the frame loop's thread.
-        if (!deviceThread_) deviceThread_ = std::make_unique<DeviceThread>();
-        auto pending = std::make_shared<PendingOpen>();
-        slot.opening = pending;
-        BoundedQueue<Event>* events = &context_.events;
-        devices::DialBox* target = &box;
-        deviceThread_->post([target, id, events, pending] {
-          pending->result = target->open(id, *events);
-          pending->done.store(true, std::memory_order_release);
-        });
-        continue;
-      }
-    }
-    box.service(now);
-    if (box.state() != slot.state) {
-      if (slot.state == devices::DeviceState::kLive) {
-        // Its bindings let go: a shuttle held when the cable was pulled stops turning.
-        slot.dials.apply(Event{now, static_cast<DeviceId>(i + 1), EventKind::kDeviceState, 0, 0.0}, context_.show);
+  const Nanos now = context_.clock.now();
+  bool changed = false;
+  for (DeviceSlot& slot : show_->devices) {
+    if (slot.id == 0) continue;
+    const auto st = std::ranges::find_if(all, [&](const devices::DeviceStatus& d) { return d.id == slot.id; });
+    if (st == all.end()) continue;
+    const bool dialBox = slot.spec.kind == DeviceKind::kDialBox;
+    const bool live = st->state == devices::DeviceState::kLive;
+    if (st->state != slot.state) {
+      if (dialBox && slot.state == devices::DeviceState::kLive) {
         log::warn(kLogDirector, "device '{}' is {}; its bindings are quiet until it comes back", slot.spec.name,
-                  devices::deviceStateName(box.state()));
-        slot.nextAttempt = now + slot.backoff;
-      } else if (box.state() == devices::DeviceState::kLive) {
-        log::info(kLogDirector, "device '{}' is live ({})", slot.spec.name, box.info().name);
+                  devices::deviceStateName(st->state));
+      } else if (dialBox && live) {
+        log::info(kLogDirector, "device '{}' is live ({})", slot.spec.name, st->device.name);
       }
-      slot.state = box.state();
-      slot.since = wall;
+      slot.state = st->state;
+      // The manager's time of the change, on the wall clock.
+      slot.since = wall - std::chrono::duration_cast<WallTime::duration>(std::max(Nanos{0}, now - st->since));
+      changed = true;
+    }
+    const std::string message = live ? std::string() : st->lastError;
+    if (message != slot.message) {
+      if (dialBox && st->attempts > 0 && !message.empty()) {
+        log::warn(kLogDirector, "device '{}' ({}): {}; retrying every {} s at most", slot.spec.name,
+                  deviceBackendName(slot.spec.backend), message, toSeconds(kDialBoxBackoff.max));
+      }
+      slot.message = message;
+      changed = true;
+    }
+    if (!st->device.name.empty() && st->device.name != slot.deviceName) {
+      slot.deviceName = st->device.name;
       changed = true;
     }
   }
+  answerRestarts(all);
   if (changed) publishDevices();
 }
 
-void ShowDirector::noteOpen(DeviceSlot& slot, const Result<void>& opened, Nanos now, bool& changed) {
-  if (opened) {
-    slot.backoff = std::chrono::seconds(1);
-    slot.message.clear();
-    return;
+void ShowDirector::answerRestarts(const std::vector<devices::DeviceStatus>& all) {
+  for (auto it = restarts_.begin(); it != restarts_.end();) {
+    const auto st = std::ranges::find_if(all, [&](const devices::DeviceStatus& d) { return d.id == it->id; });
+    if (st == all.end()) {
+      it->reply->answer(409, fmt::format("'{}' was not restarted: the show was replaced first; ask again", it->name));
+      it = restarts_.erase(it);
+      continue;
+    }
+    if (st->restarts <= it->before) {
+      ++it;
+      continue;
+    }
+    const bool live = st->state == devices::DeviceState::kLive;
+    log::info(kLogDirector, "device '{}' restarted by the control server: {}", it->name,
+              live ? std::string("live") : st->lastError);
+    // A device that is not there is not the server's fault: 503, and the manager retries.
+    it->reply->answer(
+        live ? 200 : 503,
+        live ? fmt::format("'{}' restarted", it->name)
+             : fmt::format("'{}' could not be reopened: {}; it is retried every few seconds", it->name, st->lastError));
+    it = restarts_.erase(it);
   }
-  if (slot.message != opened.error().message()) {
-    log::warn(kLogDirector, "device '{}' ({}): {}; retrying every {} s at most", slot.spec.name,
-              deviceBackendName(slot.spec.backend), opened.error().describe(), toSeconds(kMaxRetry));
-    changed = true;  // the status shows the new reason
+}
+
+DeviceSlot* ShowDirector::slotFor(DeviceId id) {
+  if (id == 0) return nullptr;
+  for (DeviceSlot& slot : show_->devices) {
+    if (slot.id == id) return &slot;
   }
-  slot.message = opened.error().message();
-  slot.nextAttempt = now + slot.backoff;
-  slot.backoff = std::min(slot.backoff * 2, kMaxRetry);
+  return nullptr;
 }
 
 void ShowDirector::applyInput(Nanos until) {
-  const Nanos now = until;
-  context_.events.drainWhile([until](const Event& e) { return e.time <= until; },
-                             [this, now](Event e) {
-                               if (e.device == 0 || e.device > show_->devices.size()) return;
-                               if (e.kind != EventKind::kDialDelta && e.kind != EventKind::kButton &&
-                                   e.kind != EventKind::kDialAbsolute && e.kind != EventKind::kShuttle) {
-                                 return;
-                               }
-                               // A visitor touched something: wake the exhibit, and count as activity.
-                               if (!follower_ && policy_->noteInput(now)) applyProgramme(now);
-                               if (!player_) return;
-                               DeviceSlot& slot =
-                                   show_->devices[e.device - 1];  // bindings keep state (acceleration, shuttles)
-                               if (e.kind == EventKind::kButton) {
-                                 if (e.value < 0.5 || e.index >= slot.buttons.size()) return;
-                                 if (follower_ && slot.buttons[e.index] != KioskAction::kResetView) return;
-                                 switch (slot.buttons[e.index]) {
-                                   case KioskAction::kNextItem:
-                                     if (policy_->next(now)) applyProgramme(now);
-                                     break;
-                                   case KioskAction::kPreviousItem:
-                                     if (policy_->previous(now)) applyProgramme(now);
-                                     break;
-                                   case KioskAction::kResetView: context_.show.resetTransforms(); break;
-                                   case KioskAction::kNone: break;
-                                 }
-                                 return;
-                               }
-                               slot.dials.apply(e, context_.show);
-                             });
+  // The run's one queue: the show's devices and a replayed trace push into it; this is where
+  // their events leave it, in the order of their times.
+  takeDueInput(context_.events, until, input_, inputLater_);
+  for (const Event& e : input_) applyEvent(e, until);
+}
+
+void ShowDirector::applyEvent(const Event& e, Nanos now) {
+  if (replayBindings_ && std::ranges::find(replayDevices_, e.device) != replayDevices_.end()) {
+    // A replayed trace turns the show through LAVA's table; it is not a visitor.
+    replayBindings_->apply(e, context_.show);
+    return;
+  }
+  DeviceSlot* slot = slotFor(e.device);
+  if (!slot) return;  // a device of a show that was replaced
+  if (e.kind == EventKind::kDeviceState) {
+    // Its bindings let go when it is lost: a shuttle held when the cable was pulled stops turning.
+    slot->dials.apply(e, context_.show);
+    return;
+  }
+  if (e.kind != EventKind::kDialDelta && e.kind != EventKind::kButton && e.kind != EventKind::kDialAbsolute &&
+      e.kind != EventKind::kShuttle) {
+    return;
+  }
+  // A visitor touched something: wake the exhibit, and count as activity.
+  if (!follower_ && policy_->noteInput(now)) applyProgramme(now);
+  if (!player_) return;
+  if (e.kind == EventKind::kButton) {
+    if (e.value < 0.5 || e.index >= slot->buttons.size()) return;
+    if (follower_ && slot->buttons[e.index] != KioskAction::kResetView) return;
+    switch (slot->buttons[e.index]) {
+      case KioskAction::kNextItem:
+        if (policy_->next(now)) applyProgramme(now);
+        break;
+      case KioskAction::kPreviousItem:
+        if (policy_->previous(now)) applyProgramme(now);
+        break;
+      case KioskAction::kResetView: context_.show.resetTransforms(); break;
+      case KioskAction::kNone: break;
+    }
+    return;
+  }
+  slot->dials.apply(e, context_.show);  // bindings keep state (acceleration, shuttles)
 }
 
 void ShowDirector::applyOutputInput(Nanos now) {
@@ -543,8 +531,11 @@ void ShowDirector::applyOutputInput(Nanos now) {
 
 void ShowDirector::advanceShuttles(Nanos now) {
   // Shuttle rings held off-centre turn the show by the show time since the last frame.
-  if (player_ && lastAdvance_.count() >= 0 && now > lastAdvance_) {
-    for (DeviceSlot& slot : show_->devices) slot.dials.advance(now - lastAdvance_, context_.show);
+  if (lastAdvance_.count() >= 0 && now > lastAdvance_) {
+    if (player_) {
+      for (DeviceSlot& slot : show_->devices) slot.dials.advance(now - lastAdvance_, context_.show);
+    }
+    if (replayBindings_) replayBindings_->advance(now - lastAdvance_, context_.show);
   }
   lastAdvance_ = now;
 }
@@ -742,8 +733,9 @@ void ShowDirector::runCommand(const FrameContext& frame, ControlRequest& request
 }
 
 Result<std::string> ShowDirector::runLeaderCommand(std::string_view command) {
-  return runScriptCommand(command, {context_.show, &context_.renderer.textures(),
-                                    show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
+  return runScriptCommand(factories_.commands, command,
+                          {context_.show, &context_.renderer.textures(),
+                           show_ ? show_->manifest.file.parent_path() : std::filesystem::path()});
 }
 
 const LockCommandLog* ShowDirector::commandLog() const { return locked_ && !follower_ ? &commands_ : nullptr; }
@@ -926,10 +918,11 @@ void ShowDirector::publishDevices() {
     d.name = slot.spec.name;
     d.kind = std::string(deviceKindName(slot.spec.kind));
     d.backend = std::string(deviceBackendName(slot.spec.backend));
-    d.state = slot.dialBox ? std::string(devices::deviceStateName(slot.dialBox->state())) : "absent";
-    d.message = slot.message.empty() && slot.dialBox ? slot.dialBox->info().name : slot.message;
+    d.state = slot.id != 0 ? std::string(devices::deviceStateName(slot.state)) : "absent";
+    d.message = !slot.message.empty() || slot.id == 0 ? slot.message
+                                                      : (slot.deviceName.empty() ? slot.spec.name : slot.deviceName);
     d.since = slot.since;
-    if (slot.spec.kind == DeviceKind::kCamera && !slot.dialBox) cameraRow(d, slot);
+    if (slot.spec.kind == DeviceKind::kCamera) cameraRow(d, slot);
     if (d.since == WallTime{}) d.since = wall;
     out.push_back(std::move(d));
   }
@@ -953,7 +946,7 @@ void ShowDirector::cameraRow(DeviceStatus& d, const DeviceSlot& slot) const {
     d.since = t.since;
     return;
   }
-  if (!slot.unavailable.starts_with("a camera")) return;  // this build cannot open it: absent, saying why
+  if (!slot.unavailable.empty()) return;  // this build cannot open it: absent, saying why
   d.state = "idle";
   d.message =
       "no texture shows it (a [textures.NAME] with source = a camera [media] naming it); a LAVA script's "

@@ -2,10 +2,11 @@
 
 /// \file
 /// \brief The show director: the frame participant that runs a loaded show. Each frame it takes
-/// a reloaded show over when one is ready, answers control requests, services the devices,
-/// applies their input (visitor activity, dial bindings, button actions), lets the kiosk policy
-/// decide what plays and switches items, display power and textures accordingly, feeds the
-/// playing item its frame, and saves where the show is.
+/// a reloaded show over when one is ready, answers control requests, hears from its
+/// devices::DeviceManager what became of the show's devices, applies the run's input (visitor
+/// activity, dial bindings, button actions, a replayed trace), lets the kiosk policy decide what
+/// plays and switches items, display power and textures accordingly, feeds the playing item its
+/// frame, and saves where the show is.
 
 #include <atomic>
 #include <cstdint>
@@ -15,7 +16,9 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <vector>
 
+#include "devices/device_manager.h"
 #include "devices/evdev/evdev_input.h"
 #include "devices/udev/udev_monitor.h"
 #include "kiosk/lock/frame_lock.h"
@@ -57,16 +60,26 @@ struct DirectorContext {
 /// the manifest on a thread of its own and hands the result over through `reloadMutex_`.
 class ShowDirector final : public FrameParticipant, public LockedDirector {
  public:
-  explicit ShowDirector(DirectorContext context);
+  /// \brief A director that reloads shows with `factories` (what the first show was loaded with)
+  /// and runs control commands with its command runner.
+  ShowDirector(DirectorContext context, ShowFactories factories);
   ~ShowDirector() override;
   ShowDirector(const ShowDirector&) = delete;
   ShowDirector& operator=(const ShowDirector&) = delete;
 
   /// \brief Installs the first show at `now`, resuming at `resume` when it still fits.
   void install(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume);
-  /// \brief Says that a device came (udev): dial boxes that are not live are tried again at
-  /// the next frame instead of after their back-off. Any thread.
-  void noteHotplug() { hotplug_.store(true, std::memory_order_release); }
+  /// \brief Says that a device came (udev): devices that are not live are tried again at once
+  /// instead of after their back-off. Any thread.
+  void noteHotplug();
+  /// \brief The manager that runs the show's devices (its dial boxes and the cameras its
+  /// textures show), for what else shows a device of the show (the scripts' VCR camera).
+  [[nodiscard]] devices::DeviceManager& devices() { return *devices_; }
+  /// \brief Devices a run adds beside its show's (`basalt run --replay`): they push into the
+  /// same queue, and their events turn the show through `bindings` (borrowed: LAVA's table, the
+  /// Zoom dials) without counting as a visitor. Their ids must not be the show's
+  /// (DeviceWiring numbers them apart).
+  void setReplayInput(runtime::Bindings* bindings, std::vector<DeviceId> devices);
   /// \brief Re-reads the manifest on a loader thread; the current show plays on until the new
   /// one is ready, and stays when the new one has errors.
   void requestReload();
@@ -106,9 +119,18 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   [[nodiscard]] std::int64_t lastReloadFrame() const { return lastReloadFrame_; }
 
  private:
-  /// Opens dial boxes off the frame loop's thread (system clock only).
-  class DeviceThread;
-  void noteOpen(DeviceSlot& slot, const Result<void>& opened, Nanos now, bool& changed);
+  /// A restart the control server asked for, answered once the manager did it.
+  struct PendingRestart {
+    std::string name;
+    DeviceId id = 0;
+    std::uint32_t before = 0;  // the device's restarts when it was asked
+    std::shared_ptr<ControlReply> reply;
+  };
+
+  /// Asks the manager for the new show's devices (and tells the camera streams where they are).
+  void requestDevices();
+  /// Whether a texture of the show shows camera `device`.
+  [[nodiscard]] bool cameraShown(const std::string& device) const;
   void watchHotplug();
   void takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const std::optional<ResumePoint>& resume);
   void pollReload(const FrameContext& frame);
@@ -118,7 +140,13 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   /// Runs a control request's script command (on a leader: logs it for the followers).
   void runCommand(const FrameContext& frame, ControlRequest& request);
   void serviceDevices(Nanos now);
+  /// Takes what the manager says about the show's devices into their slots when it changed:
+  /// the status lines, the log, the restarts asked for.
+  void mirrorDevices();
+  void answerRestarts(const std::vector<devices::DeviceStatus>& devices);
   void applyInput(Nanos until);
+  void applyEvent(const Event& e, Nanos now);
+  [[nodiscard]] DeviceSlot* slotFor(DeviceId id);
   /// Keys and pointer from the output's window and from evdev keyboards and mice: activity for the kiosk, the facet
   /// views' calibration keys (thesis Appendix B), then walking the viewer (Navigator): held keys move it per frame,
   /// dragging with a button held turns it.
@@ -142,12 +170,22 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   [[nodiscard]] ItemPlayer::Playback playbackFor(const Programme& p) const;
 
   DirectorContext context_;
+  const ShowFactories factories_;  // read by the loader thread too: never changed after construction
   DisplayViews* views_ = nullptr;
   devices::EvdevInput* keyboardsAndMice_ = nullptr;
+  // The one owner of the show's devices: opens, retries and closes them (on its own thread on
+  // the system clock, stepped by serviceDevices() under a ManualClock) and pushes their events
+  // into context_.events. Before show_, which its camera streams borrow it for.
+  std::unique_ptr<devices::DeviceManager> devices_;
+  std::vector<std::string> requested_;    // names the show holds in devices_
+  std::uint64_t devicesSeen_ = 0;         // devices_->statusVersion() last mirrored
+  std::vector<PendingRestart> restarts_;  // frame loop only
+  std::vector<Event> input_;              // the frame's input, in time order (capacity kept)
+  std::vector<Event> inputLater_;         // input taken from the queue before it was due
+  runtime::Bindings* replayBindings_ = nullptr;
+  std::vector<DeviceId> replayDevices_;
   std::unique_ptr<LoadedShow> show_;
-  std::unique_ptr<DeviceThread> deviceThread_;  // dial boxes open there on the system clock
   std::unique_ptr<devices::UdevMonitor> udev_;  // a device came: retry the absent at once
-  std::atomic<bool> hotplug_{false};
   std::unique_ptr<KioskPolicy> policy_;
   std::shared_ptr<const Schedule> scheduleForStatus_;
   ItemPlayer* player_ = nullptr;  // the playing item's player, owned by show_

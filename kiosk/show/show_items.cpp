@@ -1,8 +1,6 @@
 #include "kiosk/show/show_items.h"
 
 #include <algorithm>
-#include <array>
-#include <mutex>
 
 #include <fmt/format.h>
 
@@ -32,17 +30,6 @@ class BlackItem final : public ItemPlayer {
   }
 };
 
-struct Registry {
-  std::mutex mutex;
-  std::array<ItemFactory, 6> factories;  // by EntryKind; guarded by mutex
-  CommandRunner commands;                // guarded by mutex
-};
-
-Registry& registry() {
-  static Registry r;
-  return r;
-}
-
 std::string_view missingReader(EntryKind kind) {
   switch (kind) {
     case EntryKind::kScript: return "this build has no LAVA script interpreter";
@@ -57,22 +44,26 @@ std::string_view missingReader(EntryKind kind) {
   return "this build cannot play it";
 }
 
-}  // namespace
-
-void setItemFactory(EntryKind kind, ItemFactory factory) {
-  Registry& r = registry();
-  std::lock_guard lock(r.mutex);
-  r.factories[static_cast<std::size_t>(kind)] = std::move(factory);
+/// The factory for a kind of entry that is not built in; null for the built-in ones.
+const ItemFactory* factoryFor(EntryKind kind, const ItemFactories& factories) {
+  switch (kind) {
+    case EntryKind::kScript: return &factories.script;
+    case EntryKind::kScene: return &factories.scene;
+    case EntryKind::kModel: return &factories.model;
+    case EntryKind::kMovie: return &factories.movie;
+    case EntryKind::kBuiltinDefault:
+    case EntryKind::kBuiltinBlack: break;
+  }
+  return nullptr;
 }
 
-Result<std::unique_ptr<ItemPlayer>> prepareItem(const EntrySpec& entry, const Manifest& show) {
-  ItemFactory factory;
-  {
-    Registry& r = registry();
-    std::lock_guard lock(r.mutex);
-    factory = r.factories[static_cast<std::size_t>(entry.kind)];
+}  // namespace
+
+Result<std::unique_ptr<ItemPlayer>> prepareItem(const EntrySpec& entry, const Manifest& show,
+                                                const ItemFactories& factories) {
+  if (const ItemFactory* factory = factoryFor(entry.kind, factories); factory && *factory) {
+    return (*factory)(entry, show);
   }
-  if (factory) return factory(entry, show);
   switch (entry.kind) {
     case EntryKind::kBuiltinDefault: return std::make_unique<DefaultItem>();
     case EntryKind::kBuiltinBlack: return std::make_unique<BlackItem>();
@@ -83,19 +74,8 @@ Result<std::unique_ptr<ItemPlayer>> prepareItem(const EntrySpec& entry, const Ma
               fmt::format("{}:{}", show.file.string(), entry.line));
 }
 
-void setCommandRunner(CommandRunner runner) {
-  Registry& r = registry();
-  std::lock_guard lock(r.mutex);
-  r.commands = std::move(runner);
-}
-
-Result<std::string> runScriptCommand(std::string_view command, const CommandTarget& target) {
-  CommandRunner runner;
-  {
-    Registry& r = registry();
-    std::lock_guard lock(r.mutex);
-    runner = r.commands;
-  }
+Result<std::string> runScriptCommand(const CommandRunner& runner, std::string_view command,
+                                     const CommandTarget& target) {
   if (!runner) {
     return fail(Errc::kUnsupported, "this build has no LAVA script interpreter to run the command");
   }

@@ -4,11 +4,11 @@
 /// \brief What plays one item of a show (its entry, a playlist item, the attract loop, the
 /// standby show): the seam through which scripts, scenes, models and movies plug into the kiosk.
 ///
-/// Built in: "default" (LAVA's start-up cube) and "black". A reader for another kind of item
-/// registers a factory with setItemFactory() (the LAVA script interpreter for .mdl, the scene
-/// and model loaders for .sce/.obj/.off, the movie player for movies); until one is registered,
-/// such an item fails with a message that says so, and the kiosk moves on (DESIGN.md §8: the
-/// show goes on).
+/// Built in: "default" (LAVA's start-up cube) and "black". Another kind of item is made by its
+/// reader's factory in ItemFactories (the LAVA script interpreter for .mdl, the scene and model
+/// loaders for .sce/.obj/.off, the movie player for movies), which the program builds where it
+/// starts (app/show_factories.cpp) and passes down to the loader; without one, such an item
+/// fails with a message that says so, and the kiosk moves on (DESIGN.md §8: the show goes on).
 
 #include <chrono>
 #include <filesystem>
@@ -20,6 +20,7 @@
 
 #include "kiosk/loop/frame_loop.h"
 #include "kiosk/manifest/manifest.h"
+#include "media/frame_picker.h"
 #include "render/output.h"
 #include "render/texture_registry.h"
 #include "runtime/error.h"
@@ -27,13 +28,9 @@
 
 namespace basalt::kiosk {
 
-/// \brief Frame-locked followers: how a movie came by the frame it showed in the last frame.
-enum class LeaderFrameResult : std::uint8_t {
-  kNone,       ///< no frame of the leader's was given (a leader, an unlocked show, the leader shows none)
-  kAgreed,     ///< the leader's frame, which this node's own timeline picked too
-  kCorrected,  ///< the leader's frame, which this node's own timeline would not have picked
-  kLate,       ///< the leader's frame did not come in time: the frame before it stayed
-};
+/// \brief Frame-locked followers: how a movie came by the frame it showed in the last frame
+/// (kNone: no frame of the leader's was given: a leader, an unlocked show, the leader shows none).
+using LeaderFrameResult = media::FrameOutcome;
 
 /// \brief Plays one item into the Show.
 ///
@@ -88,11 +85,19 @@ class ItemPlayer {
 /// \brief Makes the player of an entry. Called off the frame loop's thread.
 using ItemFactory = std::function<Result<std::unique_ptr<ItemPlayer>>(const EntrySpec& entry, const Manifest& show)>;
 
-/// \brief Registers the factory for a kind of entry (call before the first show loads).
-void setItemFactory(EntryKind kind, ItemFactory factory);
+/// \brief The makers of the items that are not built in, one per kind of entry. One left empty
+/// makes such items unplayable, with a message that says so.
+struct ItemFactories {
+  ItemFactory script;  ///< LAVA scripts (.mdl)
+  ItemFactory scene;   ///< scenes (.sce)
+  ItemFactory model;   ///< models (.obj, .off)
+  ItemFactory movie;   ///< movies, full screen
+};
 
-/// \brief The player of `entry`, or why it cannot be played in this build.
-[[nodiscard]] Result<std::unique_ptr<ItemPlayer>> prepareItem(const EntrySpec& entry, const Manifest& show);
+/// \brief The player of `entry` ("default" and "black" are built in, the rest made by
+/// `factories`), or why it cannot be played in this build.
+[[nodiscard]] Result<std::unique_ptr<ItemPlayer>> prepareItem(const EntrySpec& entry, const Manifest& show,
+                                                              const ItemFactories& factories);
 
 /// \brief What a control command runs on.
 struct CommandTarget {
@@ -103,9 +108,8 @@ struct CommandTarget {
 
 /// \brief Runs one LAVA script command on the show (the control server's "run a command").
 using CommandRunner = std::function<Result<std::string>(std::string_view command, const CommandTarget& target)>;
-/// \brief Registers the script interpreter's command runner (call before the first show loads).
-void setCommandRunner(CommandRunner runner);
-/// \brief Runs `command`, or says that this build cannot.
-[[nodiscard]] Result<std::string> runScriptCommand(std::string_view command, const CommandTarget& target);
+/// \brief Runs `command` with `runner`, or says that this build cannot (`runner` is empty).
+[[nodiscard]] Result<std::string> runScriptCommand(const CommandRunner& runner, std::string_view command,
+                                                   const CommandTarget& target);
 
 }  // namespace basalt::kiosk

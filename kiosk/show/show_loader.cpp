@@ -1,14 +1,12 @@
 #include "kiosk/show/show_loader.h"
 
-#include <mutex>
-
 #include <fmt/format.h>
 #include <fmt/std.h>
 
 #include "kiosk/manifest/content_check.h"
 #include "media/image_io.h"
 #include "runtime/log.h"
-#include "sim/synthetic_dial.h"
+#include "sim/providers.h"
 
 namespace basalt::kiosk {
 
@@ -16,49 +14,43 @@ BASALT_LOG_CATEGORY(Loader, "kiosk");
 
 namespace {
 
-struct Factories {
-  std::mutex mutex;
-  std::array<StreamFactory, 3> streams;  // by MediaKind; guarded by mutex
-  std::array<DialBoxFactory, 6> dials;   // by DeviceBackend; guarded by mutex
-};
-
-Factories& factories() {
-  static Factories f;
-  return f;
+/// A synthetic dial box playing the manifest's script, in a backend of its own.
+DeviceSource syntheticDialBox(const DeviceSpec& spec) {
+  sim::SyntheticProvider::Device device;
+  device.candidate = {sim::SyntheticDial::defaultInfo(), devices::DeviceKind::kDialBox, "", "the manifest's script"};
+  device.script.reserve(spec.script.size());
+  for (const SyntheticInput& in : spec.script) {
+    const EventKind kind = in.button ? EventKind::kButton : (in.shuttle ? EventKind::kShuttle : EventKind::kDialDelta);
+    device.script.push_back({in.at, kind, in.index, in.value});
+  }
+  device.loop = spec.loop;
+  DeviceSource source;
+  source.provider = std::make_unique<sim::SyntheticProvider>(std::vector{std::move(device)});
+  source.request.kind = devices::DeviceKind::kDialBox;
+  source.request.match.backend = "synthetic";
+  source.request.options["loop"] = spec.loop ? "true" : "false";
+  return source;
 }
 
-Result<std::unique_ptr<devices::DialBox>> makeDialBox(const DeviceSpec& spec, const Clock& clock) {
-  DialBoxFactory factory;
-  {
-    std::lock_guard lock(factories().mutex);
-    factory = factories().dials[static_cast<std::size_t>(spec.backend)];
+Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec, const ShowFactories& factories) {
+  const bool dialBox = spec.kind == DeviceKind::kDialBox;
+  if (dialBox && spec.backend == DeviceBackend::kSynthetic) return syntheticDialBox(spec);
+  if (factories.devices) return factories.devices(spec);
+  return fail(Errc::kUnsupported, fmt::format("this build has no {} {} backend", deviceBackendName(spec.backend),
+                                              dialBox ? "dial box" : "camera"));
+}
+
+/// The factory for the texture stream of `kind` (movies and cameras); null for images.
+const StreamFactory* streamFactory(MediaKind kind, const ShowFactories& factories) {
+  switch (kind) {
+    case MediaKind::kMovie: return &factories.movieStreams;
+    case MediaKind::kCamera: return &factories.cameraStreams;
+    case MediaKind::kImage: break;
   }
-  if (factory) return factory(spec, clock);
-  if (spec.backend == DeviceBackend::kSynthetic) {
-    std::vector<sim::ScriptedInput> script;
-    script.reserve(spec.script.size());
-    for (const SyntheticInput& in : spec.script) {
-      const EventKind kind =
-          in.button ? EventKind::kButton : (in.shuttle ? EventKind::kShuttle : EventKind::kDialDelta);
-      script.push_back({in.at, kind, in.index, in.value});
-    }
-    return std::make_unique<sim::SyntheticDial>(std::move(script), clock, spec.loop);
-  }
-  return fail(Errc::kUnsupported,
-              fmt::format("this build has no {} dial box backend", deviceBackendName(spec.backend)));
+  return nullptr;
 }
 
 }  // namespace
-
-void setStreamFactory(MediaKind kind, StreamFactory factory) {
-  std::lock_guard lock(factories().mutex);
-  factories().streams[static_cast<std::size_t>(kind)] = std::move(factory);
-}
-
-void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory) {
-  std::lock_guard lock(factories().mutex);
-  factories().dials[static_cast<std::size_t>(backend)] = std::move(factory);
-}
 
 std::string entryKey(const EntrySpec& entry) { return entry.path.empty() ? entry.text : entry.path.string(); }
 
@@ -71,7 +63,8 @@ std::optional<Image> readTextureImage(const std::string& texture, const std::fil
   return std::move(*image);
 }
 
-Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock, bool readImages) {
+Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock, const ShowFactories& factories,
+                                             bool readImages) {
   auto show = std::make_unique<LoadedShow>();
   show->manifest = std::move(manifest);
   const Manifest& m = show->manifest;
@@ -89,7 +82,7 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
   for (const EntrySpec* entry : entries) {
     const std::string key = entryKey(*entry);
     if (show->players.contains(key) || show->unplayable.contains(key)) continue;
-    auto player = prepareItem(*entry, m);
+    auto player = prepareItem(*entry, m, factories.items);
     if (player) {
       show->players.emplace(key, std::move(*player));
     } else {
@@ -98,17 +91,25 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
     }
   }
 
-  // Devices and their bindings: LAVA's dial table for a dial box no binding mentions.
+  // Devices and their bindings: LAVA's dial table for a dial box no binding mentions. Nothing
+  // is opened here: the director asks its DeviceManager for them.
   for (const DeviceSpec& spec : m.devices) {
     DeviceSlot slot;
     slot.spec = spec;
-    if (spec.kind == DeviceKind::kDialBox) {
-      auto box = makeDialBox(spec, clock);
-      if (box) {
-        slot.dialBox = std::move(*box);
-      } else {
-        slot.unavailable = box.error().message();
+    auto source = makeDeviceSource(spec, factories);
+    if (source) {
+      slot.source = std::move(*source);
+      slot.source.request.name = spec.name;
+      if (spec.kind == DeviceKind::kDialBox) {
+        // The director says what happens to a show's dial box (its status line, its log), and
+        // retries it less eagerly than a camera.
+        slot.source.upkeep.backoff = kDialBoxBackoff;
+        slot.source.upkeep.quiet = true;
       }
+    } else {
+      slot.unavailable = source.error().message();
+    }
+    if (spec.kind == DeviceKind::kDialBox) {
       // LAVA's dial table with the device's gain and acceleration, then each binding's
       // override of one dial (the others keep LAVA's action).
       slot.dials = runtime::Bindings::lavaDefaults();
@@ -129,16 +130,6 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
         dial.invert = b.invert;
         slot.dials.setDial(b.index, dial);
       }
-    } else {
-      // A camera is opened and kept by the texture stream of the media that shows it (its own
-      // DeviceManager); its slot only names it in the status.
-      StreamFactory cameras;
-      {
-        std::lock_guard lock(factories().mutex);
-        cameras = factories().streams[static_cast<std::size_t>(MediaKind::kCamera)];
-      }
-      slot.unavailable = cameras ? fmt::format("a camera: its state is on the stream of the media that shows it")
-                                 : fmt::format("this build has no {} camera backend", deviceBackendName(spec.backend));
     }
     slot.message = slot.unavailable;
     show->devices.push_back(std::move(slot));
@@ -154,13 +145,9 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
       if (media->kind == MediaKind::kImage) {
         t.imageFile = media->file;
       } else {
-        StreamFactory factory;
-        {
-          std::lock_guard lock(factories().mutex);
-          factory = factories().streams[static_cast<std::size_t>(media->kind)];
-        }
-        if (factory) {
-          auto stream = factory(*media, m, clock);
+        const StreamFactory* factory = streamFactory(media->kind, factories);
+        if (factory && *factory) {
+          auto stream = (*factory)(*media, m, clock);
           if (stream) {
             t.stream = std::move(*stream);
           } else {
@@ -180,7 +167,7 @@ Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clo
 }
 
 Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path& file, const Clock& clock,
-                                                    Diagnostics& diagnostics) {
+                                                    const ShowFactories& factories, Diagnostics& diagnostics) {
   ReadOptions options;
   options.fileCheckers = &contentCheckers();
   auto manifest = readManifest(file, diagnostics, options);
@@ -188,7 +175,7 @@ Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path&
     return fail(Errc::kParse, fmt::format("{} has {} problem{}", file.string(), diagnostics.errorCount(),
                                           diagnostics.errorCount() == 1 ? "" : "s"));
   }
-  return loadShow(std::move(*manifest), clock, true);
+  return loadShow(std::move(*manifest), clock, factories, true);
 }
 
 }  // namespace basalt::kiosk

@@ -6,10 +6,12 @@
 /// nothing on the screen, so it runs off the frame loop's thread (at start and on SIGHUP) while
 /// the current show keeps playing; the director installs the result between two frames.
 ///
-/// Seams for the parts other efforts build: setDialBoxFactory() for the hid and replay dial
-/// boxes, setStreamFactory() for movie and camera textures (kiosk/show/show_items.h has the item
-/// seam). Without one, the device or stream is reported absent with the reason, its bindings
-/// stay quiet and its texture shows the fallback: the show goes on.
+/// What it makes items, devices and texture streams with comes in a ShowFactories value, built
+/// where the program starts (app/show_factories.cpp) and passed down to the loader and the
+/// director. Without a factory, the item is unplayable, or the device or stream is reported
+/// absent with the reason, its bindings stay quiet and its texture shows the fallback: the show
+/// goes on. Loading opens no device: the director asks its devices::DeviceManager for them when
+/// the show takes over.
 
 #include <array>
 #include <chrono>
@@ -21,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "devices/dial_box.h"
+#include "devices/device_manager.h"
 #include "kiosk/manifest/manifest.h"
 #include "kiosk/policy/kiosk_policy.h"
 #include "kiosk/policy/schedule.h"
@@ -74,37 +76,59 @@ class TextureStream {
   virtual void setLeaderFrame(std::int64_t frame) { (void)frame; }
   /// \brief What the last update() did with the leader's frame.
   [[nodiscard]] virtual LeaderFrameResult leaderFrameResult() const { return LeaderFrameResult::kNone; }
+  /// \brief Cameras: the manager that runs the show's devices, where the stream finds its
+  /// camera by name (the director requested it there). Called by the director before the first
+  /// update(); borrowed, it outlives the stream. Streams without a device ignore it.
+  virtual void useDevices(devices::DeviceManager& devices) { (void)devices; }
 };
 
+/// \brief Makes the texture stream of a movie or camera. Called off the frame loop's thread.
 using StreamFactory = std::function<Result<std::unique_ptr<TextureStream>>(const MediaSpec& media, const Manifest& show,
                                                                            const Clock& clock)>;
-/// \brief Registers the stream maker for movies or cameras (call before the first show loads).
-void setStreamFactory(MediaKind kind, StreamFactory factory);
 
-using DialBoxFactory =
-    std::function<Result<std::unique_ptr<devices::DialBox>>(const DeviceSpec& device, const Clock& clock)>;
-/// \brief Registers the dial box maker for a backend (hid, replay). The synthetic backend is
-/// built in.
-void setDialBoxFactory(DeviceBackend backend, DialBoxFactory factory);
+/// \brief How a show's device is found: the backend that lists and opens it (loaded with the
+/// device's trace, port or script), what the DeviceManager is asked for, and how it keeps it.
+struct DeviceSource {
+  std::unique_ptr<devices::DeviceProvider> provider;
+  devices::DeviceRequest request;
+  devices::Upkeep upkeep;
+};
 
-/// \brief An open of a dial box running on the director's device thread (system clock).
-struct PendingOpen;
+/// \brief Makes the source of a device (dial box or camera; the spec says which) for a backend
+/// other than the built-in synthetic dial box. Called off the frame loop's thread.
+using DeviceFactory = std::function<Result<DeviceSource>(const DeviceSpec& device)>;
+
+/// \brief What a show's items, texture streams and devices are made with, and what runs the
+/// control server's script commands. A plain value: the program builds it where it starts
+/// (app/show_factories.cpp) and hands it to loadShow() and the ShowDirector; tests build the one
+/// they need. An empty member makes what it would make unplayable or absent, with a message that
+/// says so. Threading: the loader's thread calls the factories; they keep no state of their own.
+struct ShowFactories {
+  ItemFactories items;
+  StreamFactory movieStreams;   ///< textures fed by a movie file
+  StreamFactory cameraStreams;  ///< textures fed by a camera
+  DeviceFactory devices;        ///< hid, serial, replay, v4l2 and libcamera devices (synthetic dial boxes are built in)
+  CommandRunner commands;       ///< the control server's "run a command"
+};
+
+/// \brief How long a show's dial box that cannot be opened waits before the next try: 1 s,
+/// doubling to 30 s (cameras keep the DeviceManager's own).
+inline constexpr devices::Backoff kDialBoxBackoff{std::chrono::seconds(1), std::chrono::seconds(30)};
 
 /// \brief One device of a show, with what its inputs do.
 struct DeviceSlot {
   DeviceSpec spec;
-  std::unique_ptr<devices::DialBox> dialBox;  ///< null when this build cannot make it
-  std::string unavailable;                    ///< why there is no device, when there is none
-  runtime::Bindings dials;                    ///< what its dials do to the show
-  std::array<KioskAction, 32> buttons{};      ///< what its buttons do to the kiosk
-  // Kept by the director:
+  /// What the director requests (the provider moves into its DeviceManager then).
+  DeviceSource source;
+  std::string unavailable;                ///< why it cannot be requested ("" when it can)
+  runtime::Bindings dials;                ///< what its dials do to the show
+  std::array<KioskAction, 32> buttons{};  ///< what its buttons do to the kiosk
+  // What the director's DeviceManager says about it, mirrored by the director:
+  DeviceId id = 0;  ///< the id its events carry; 0 while it is not requested
   devices::DeviceState state = devices::DeviceState::kAbsent;
-  std::string message;
+  std::string message;     ///< why it is not live (the manager's last error)
+  std::string deviceName;  ///< the device in use, or the last one used
   WallTime since{};
-  Nanos nextAttempt{0};
-  Nanos backoff{std::chrono::seconds(1)};
-  /// An open running on the director's device thread: until it is done, that thread owns the box.
-  std::shared_ptr<PendingOpen> opening;
 };
 
 /// \brief One named texture of a show.
@@ -135,16 +159,18 @@ std::string entryKey(const EntrySpec& entry);
 
 /// \brief Prepares a validated manifest. Errors only for what makes the show impossible (a time
 /// zone that vanished); unplayable items, devices and streams are recorded and reported.
-/// Without `readImages` texture images are left for the director to read in the background
-/// (start-up: the first frame does not wait for image decoding).
+/// Items, streams and dial boxes are made with `factories`. Without `readImages` texture images
+/// are left for the director to read in the background (start-up: the first frame does not wait
+/// for image decoding).
 [[nodiscard]] Result<std::unique_ptr<LoadedShow>> loadShow(Manifest manifest, const Clock& clock,
-                                                           bool readImages = true);
+                                                           const ShowFactories& factories, bool readImages = true);
 
 /// \brief Reads a texture's image, or says why not (a warning) and returns nothing.
 std::optional<Image> readTextureImage(const std::string& texture, const std::filesystem::path& file);
 
 /// \brief Reads, validates and loads `file`: what a reload does on its own thread.
 [[nodiscard]] Result<std::unique_ptr<LoadedShow>> readAndLoadShow(const std::filesystem::path& file, const Clock& clock,
+                                                                  const ShowFactories& factories,
                                                                   Diagnostics& diagnostics);
 
 }  // namespace basalt::kiosk

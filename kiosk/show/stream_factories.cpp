@@ -1,6 +1,5 @@
 #include "kiosk/show/stream_factories.h"
 
-#include "kiosk/show/movie_item.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/trace_video_glue.h"
 
@@ -16,6 +15,7 @@
 #include "devices/libcamera/libcamera_camera.h"
 #include "devices/serial/sgi_dial_box.h"
 #include "devices/v4l2/v4l2_camera.h"
+#include "media/frame_picker.h"
 #include "media/mjpeg_decoder.h"
 #include "media/movie_player.h"
 #include "render/stream_texture.h"
@@ -29,86 +29,6 @@ namespace basalt::kiosk {
 BASALT_LOG_CATEGORY(Streams, "kiosk");
 
 namespace {
-
-// ---------------------------------------------------------------------------------------------
-// Dial boxes found by a rule
-
-class MatchedDialBox final : public devices::DialBox {
- public:
-  MatchedDialBox(std::unique_ptr<devices::DeviceProvider> provider, devices::DeviceRequest request, const Clock& clock)
-      : DialBox(devices::DeviceInfo{request.name, std::string(provider->backend()), "", 0, 0, "", ""}, 0, 0),
-        provider_(std::move(provider)),
-        request_(std::move(request)),
-        clock_(clock),
-        inner_(1024) {}
-
-  ~MatchedDialBox() override { close(); }
-  MatchedDialBox(const MatchedDialBox&) = delete;
-  MatchedDialBox& operator=(const MatchedDialBox&) = delete;
-
- private:
-  Result<void> doOpen() override {
-    std::string problems;
-    for (const devices::DeviceCandidate& c : provider_->enumerate()) {
-      if (c.kind != devices::DeviceKind::kDialBox || !request_.match.matches(c.info)) continue;
-      if (!c.problem.empty()) {
-        problems += fmt::format("; {}: {}", devices::describeDevice(c.info), c.problem);
-        continue;
-      }
-      auto box = provider_->openDialBox(c, request_, clock_);
-      if (!box) {
-        problems += fmt::format("; {}", box.error().describe());
-        continue;
-      }
-      Event stale;
-      while (inner_.pop(stale)) {
-      }
-      if (auto r = (*box)->open(1, inner_); !r) {
-        problems += fmt::format("; {}", r.error().describe());
-        continue;
-      }
-      device_ = std::move(*box);
-      setInfo(device_->info());
-      setShape(device_->dialCount(), device_->buttonCount());
-      return {};
-    }
-    if (problems.empty()) {
-      return fail(Errc::kNotFound, fmt::format("no {} is plugged in", request_.match.describe()));
-    }
-    return fail(Errc::kUnavailable, fmt::format("{} found but not usable{}", request_.match.describe(), problems));
-  }
-
-  void doClose() override {
-    if (device_) device_->close();
-    device_.reset();
-  }
-
-  void doService(Nanos now) override {
-    if (!device_) return;
-    device_->service(now);
-    Event e;
-    while (inner_.pop(e)) {
-      if (e.kind == EventKind::kDeviceState) continue;
-      emit(e);
-    }
-    if (device_->state() != devices::DeviceState::kLive) {
-      auto why = device_->lostReason();
-      reportLost(why ? *why
-                     : Error{Errc::kIo, fmt::format("{} stopped", devices::describeDevice(device_->info())), {}});
-    }
-  }
-
-  Result<void> doSetLight(int index, double level, bool pulse) override {
-    if (!device_) return fail(Errc::kUnavailable, "the dial box is not connected");
-    return device_->setLight(index, level, pulse);
-  }
-
-  std::unique_ptr<devices::DeviceProvider> provider_;
-  devices::DeviceRequest request_;
-  const Clock& clock_;
-  BoundedQueue<Event> inner_;  // the device's events, passed on in doService()
-  std::unique_ptr<devices::DialBox> device_;
-};
 
 // ---------------------------------------------------------------------------------------------
 // Movies
@@ -140,35 +60,23 @@ class MovieStream final : public TextureStream {
       }
       texture_ = std::move(*texture);
     }
-    // Offline (ManualClock) runs wait for the frame due, so that every frame is exact; a show
-    // on the system clock never waits (the newest frame due is shown, or the last one stays),
-    // except a frame-locked follower, which must draw the leader's frame (bounded).
-    const std::chrono::milliseconds patience = manualClock_ ? std::chrono::milliseconds(10000) : patience_;
     if (origin_ && !aligned_) {
-      align(showTime, patience);
+      align(showTime, media::framePatience(manualClock_, patience_));
       // Nothing before the movie is on the group's timeline: a node that showed the clip's first
       // frame meanwhile would show another frame than the others.
       const media::MovieState now = player_->state();
       if (!aligned_ && now != media::MovieState::kFailed && now != media::MovieState::kEmpty) return false;
     }
-    FrameRef frame;
-    if (origin_ && leaderFrame_ >= 0) {
-      // A follower shows the leader's frame by its number, not by its own decoder's timestamps
-      // (a loop of its can come out a fraction of a millisecond longer than the leader's).
-      media::NumberedFrame pick = player_->frameNumbered(leaderFrame_, showTime, patience);
-      frame = std::move(pick.frame);
-      leaderResult_ = leaderFrameResultOf(pick.outcome);
-    } else {
-      if (patience.count() > 0) player_->waitForFrameDue(showTime, patience);
-      frame = player_->frameAt(showTime);
-      if (origin_ && frame && patience.count() > 0) {
-        // The frame a seek onto the group's timeline brought is due when the seek was asked for;
-        // a node that waited for it takes the frame due now as well, so that it shows what the
-        // others show in this very frame.
-        player_->waitForFrameDue(showTime, patience);
-        if (FrameRef newer = player_->frameAt(showTime)) frame = std::move(newer);
-      }
-    }
+    // Offline (ManualClock) runs wait for the frame due, so that every frame is exact; a show
+    // on the system clock never waits (the newest frame due is shown, or the last one stays),
+    // except a frame-locked node, which must draw the group's frame (bounded by its patience).
+    media::PickedFrame pick = media::pickFrame(*player_, {.showTime = showTime,
+                                                          .leaderFrame = origin_ ? leaderFrame_ : -1,
+                                                          .manualClock = manualClock_,
+                                                          .patience = patience_,
+                                                          .onGroupTimeline = origin_.has_value()});
+    FrameRef frame = std::move(pick.frame);
+    leaderResult_ = pick.outcome;
     const media::MovieState state = player_->state();
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) {
       if (!reportedFailure_) {
@@ -265,6 +173,8 @@ class MovieStream final : public TextureStream {
   std::string failure_;
 };
 
+}  // namespace
+
 Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, const Manifest& /*show*/,
                                                        const Clock& clock) {
   std::error_code ec;
@@ -278,6 +188,8 @@ Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, c
   if (!player) return std::unexpected(player.error());
   return std::make_unique<MovieStream>(media, std::move(*player), clock.isManual());
 }
+
+namespace {
 
 // ---------------------------------------------------------------------------------------------
 // Cameras
@@ -328,44 +240,49 @@ class MjpegTap final : public devices::FrameTap {
   std::atomic<std::uint64_t> pushed_{0};
 };
 
+/// A camera's texture. The camera itself is the DeviceManager's: the director requested it when
+/// the show took over, and the stream only reads its frames and its state by the device's name.
+/// The scripts' VCR camera, which no director requests, holds the camera itself (shares the
+/// request if one is there, else makes it) and gives it back when the VCR lets it go.
 class CameraStream final : public TextureStream {
  public:
-  CameraStream(const MediaSpec& media, std::unique_ptr<devices::DeviceProvider> provider,
-               devices::DeviceRequest request, const Clock& clock)
+  /// `ownSource` makes the request when the stream must hold the camera itself (the VCR's).
+  CameraStream(const MediaSpec& media, std::string device, const Clock& clock,
+               std::function<Result<DeviceSource>()> ownSource = nullptr)
       : media_(media.name),
         onLoss_(media.onLoss),
         lossColour_(media.lossColour),
         clock_(clock),
-        events_(256),
-        mjpeg_(request.name),
-        manager_(clock, events_),
-        name_(request.name) {
-    manager_.setTaps(nullptr, &mjpeg_);
-    manager_.addProvider(std::move(provider));
-    requested_ = manager_.request(std::move(request)).has_value();
-    stream_ = manager_.videoStream(name_);
+        mjpeg_(std::make_shared<MjpegTap>(device)),
+        name_(std::move(device)),
+        ownSource_(std::move(ownSource)) {}
+  ~CameraStream() override {
+    if (!devices_) return;
+    devices_->removeFrameTap(name_, mjpeg_.get());
+    if (holds_) devices_->withdraw(name_);
   }
-  ~CameraStream() override { manager_.stop(); }
   CameraStream(const CameraStream&) = delete;
   CameraStream& operator=(const CameraStream&) = delete;
 
+  void useDevices(devices::DeviceManager& devices) override {
+    if (devices_) return;
+    devices_ = &devices;
+    // The VCR's camera: shared with a texture that shows it, else requested here.
+    if (ownSource_) holds_ = devices.share(name_).has_value() || requestOwn(devices);
+    stream_ = devices.videoStream(name_);
+    // Every JPEG the camera delivers goes to this stream's decoder on the producer's thread.
+    if (stream_) devices.addFrameTap(name_, mjpeg_);
+  }
+
   bool update(Nanos showTime, render::TextureRegistry& textures, const std::string& name) override {
-    if (!started_) {
-      started_ = true;
-      // On the system clock the manager opens and reopens the camera on a thread of its own;
-      // under a ManualClock it is stepped here, frame by frame, so that a run is repeatable.
-      if (!clock_.isManual()) manager_.start();
-    }
-    if (clock_.isManual()) manager_.step(showTime);
-    Event stale;
-    while (events_.pop(stale)) {
-    }
-    if (!stream_ || !requested_) return false;
+    // The manager opens and reopens the camera (on its thread on the system clock; stepped by
+    // the director before this update under a ManualClock, so that a run is repeatable).
+    if (!stream_ || !usable_) return false;
     if (!texture_) {
       auto texture = render::StreamTexture::create(name);
       if (!texture) {
         log::error(kLogStreams, "camera '{}': {}", media_, texture.error().describe());
-        requested_ = false;
+        usable_ = false;
         return false;
       }
       texture_ = std::move(*texture);
@@ -379,7 +296,7 @@ class CameraStream final : public TextureStream {
     if ((frame && frame->format == PixelFormat::kMjpeg) || (mode && mode->format == PixelFormat::kMjpeg)) {
       // The JPEG went to the decoder when the camera delivered it (MjpegTap): show the newest
       // decoded frame due. A ManualClock run waits for the decoder, so that every run is exact.
-      if (const std::string failure = mjpeg_.failure(); !failure.empty()) {
+      if (const std::string failure = mjpeg_->failure(); !failure.empty()) {
         if (!reportedMjpegFailure_) {
           reportedMjpegFailure_ = true;
           log::error(kLogStreams,
@@ -389,9 +306,9 @@ class CameraStream final : public TextureStream {
         }
         return false;
       }
-      const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_.decoder();
+      const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_->decoder();
       if (!decoder) return false;
-      if (clock_.isManual()) (void)decoder->waitForFinished(mjpeg_.pushed(), std::chrono::seconds(10));
+      if (clock_.isManual()) (void)decoder->waitForFinished(mjpeg_->pushed(), std::chrono::seconds(10));
       frame = decoder->frameAt(showTime);
     }
     auto changed = texture_->update(frame);
@@ -464,7 +381,8 @@ class CameraStream final : public TextureStream {
   [[nodiscard]] std::optional<SourceState> deviceState() const override { return state_; }
 
   [[nodiscard]] std::string describe() const override {
-    for (const devices::DeviceStatus& s : manager_.status()) {
+    if (!devices_) return fmt::format("camera '{}' has no device manager to find it in", name_);
+    for (const devices::DeviceStatus& s : devices_->status()) {
       if (s.name != name_) continue;
       if (s.state == devices::DeviceState::kLive) {
         return fmt::format("camera {}: {}{}{}", devices::describeDevice(s.device),
@@ -477,9 +395,21 @@ class CameraStream final : public TextureStream {
     return fmt::format("camera '{}' was not requested", name_);
   }
 
+  /// Asks `devices` for the camera itself; whether it holds it now.
+  bool requestOwn(devices::DeviceManager& devices) {
+    auto source = ownSource_();
+    if (!source) {
+      log::error(kLogStreams, "camera '{}': {}", name_, source.error().describe());
+      return false;
+    }
+    auto id = devices.request(std::move(source->request), std::move(source->provider), source->upkeep);
+    if (!id) log::error(kLogStreams, "camera '{}': {}", name_, id.error().describe());
+    return id.has_value();
+  }
+
   /// For tests: the thread the camera's JPEGs are decoded on; none before the first.
   [[nodiscard]] std::optional<std::thread::id> mjpegDecodeThread() const {
-    const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_.decoder();
+    const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_->decoder();
     if (!decoder || decoder->decodeThread() == std::thread::id{}) return std::nullopt;
     return decoder->decodeThread();
   }
@@ -487,10 +417,10 @@ class CameraStream final : public TextureStream {
  private:
   /// ", JPEG decoded off the frame loop, 2 corrupt JPEGs dropped" for an MJPEG camera.
   [[nodiscard]] std::string describeMjpeg() const {
-    if (const std::string failure = mjpeg_.failure(); !failure.empty()) {
+    if (const std::string failure = mjpeg_->failure(); !failure.empty()) {
       return fmt::format(", MJPEG that cannot be decoded ({}); showing {}", failure, lossName());
     }
-    const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_.decoder();
+    const std::shared_ptr<media::MjpegDecoder> decoder = mjpeg_->decoder();
     if (!decoder) return "";
     const std::uint64_t corrupt = decoder->corrupt();
     return fmt::format(
@@ -506,41 +436,52 @@ class CameraStream final : public TextureStream {
   std::shared_ptr<FramePool> patternPool_;
   std::uint64_t patternSequence_ = 0;
   const Clock& clock_;
-  BoundedQueue<Event> events_;  // state events of the manager; the status comes from status()
-  MjpegTap mjpeg_;              // before manager_: its frame tap, so it outlives the manager's threads
+  std::shared_ptr<MjpegTap> mjpeg_;  // shared with the manager, which may hand it a frame after we go
   bool reportedMjpegFailure_ = false;
-  devices::DeviceManager manager_;
-  std::string name_;
-  bool requested_ = false;
-  bool started_ = false;
+  std::string name_;  // the camera's device name
+  std::function<Result<DeviceSource>()> ownSource_;
+  devices::DeviceManager* devices_ = nullptr;  // borrowed: outlives the stream
+  bool holds_ = false;                         // this stream holds the camera's request (the VCR's)
+  bool usable_ = true;                         // false once its texture cannot be made
   std::shared_ptr<devices::ManagedVideoStream> stream_;
   std::unique_ptr<render::StreamTexture> texture_;
 };
 
+const DeviceSpec* cameraSpec(const Manifest& show, const std::string& device) {
+  for (const DeviceSpec& d : show.devices) {
+    if (d.name == device) return d.kind == DeviceKind::kCamera ? &d : nullptr;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, const Manifest& show,
                                                         const Clock& clock) {
-  const DeviceSpec* spec = nullptr;
-  for (const DeviceSpec& d : show.devices) {
-    if (d.name == media.device) spec = &d;
-  }
-  if (!spec || spec->kind != DeviceKind::kCamera) {
+  if (!cameraSpec(show, media.device)) {
     return fail(Errc::kNotFound, fmt::format("media '{}': no camera '{}' in [devices]", media.name, media.device));
   }
-  auto provider = providerFor(*spec);
-  if (!provider) return std::unexpected(provider.error());
+  return std::make_unique<CameraStream>(media, media.device, clock);
+}
+
+namespace {
+
+/// The DeviceManager's request for a camera of the manifest: its size, format, mirror, and the
+/// synthetic backend's scripted faults.
+devices::DeviceRequest cameraRequest(const DeviceSpec& spec) {
   devices::DeviceRequest request;
-  request.name = spec->name;
+  request.name = spec.name;
   request.kind = devices::DeviceKind::kVideoSource;
-  request.match = deviceMatchFor(*spec);
-  if (spec->width && spec->height) request.options["size"] = fmt::format("{}x{}", *spec->width, *spec->height);
-  if (spec->backend == DeviceBackend::kReplay || spec->backend == DeviceBackend::kSynthetic) {
-    request.options["loop"] = spec->loop ? "true" : "false";
+  request.match = deviceMatchFor(spec);
+  if (spec.width && spec.height) request.options["size"] = fmt::format("{}x{}", *spec.width, *spec.height);
+  if (spec.backend == DeviceBackend::kReplay || spec.backend == DeviceBackend::kSynthetic) {
+    request.options["loop"] = spec.loop ? "true" : "false";
   }
-  if (!spec->format.empty()) request.options["format"] = spec->format;
-  request.controls.mirror = spec->mirror;
-  if (spec->backend == DeviceBackend::kSynthetic && !spec->faults.empty()) {
+  if (!spec.format.empty()) request.options["format"] = spec.format;
+  request.controls.mirror = spec.mirror;
+  if (spec.backend == DeviceBackend::kSynthetic && !spec.faults.empty()) {
     std::string faults;
-    for (const SyntheticFault& f : spec->faults) {
+    for (const SyntheticFault& f : spec.faults) {
       if (!faults.empty()) faults += ',';
       switch (f.kind) {
         case SyntheticFault::Kind::kUnplug: faults += fmt::format("unplug@{}", f.at.count()); break;
@@ -555,12 +496,11 @@ Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, 
     }
     request.options["faults"] = faults;
   }
-  return std::make_unique<CameraStream>(media, std::move(*provider), std::move(request), clock);
+  return request;
 }
 
-Result<std::unique_ptr<devices::DialBox>> makeDialBoxFromSpec(const DeviceSpec& spec, const Clock& clock) {
-  auto provider = providerFor(spec);
-  if (!provider) return std::unexpected(provider.error());
+/// The DeviceManager's request for a dial box of the manifest.
+Result<devices::DeviceRequest> dialBoxRequest(const DeviceSpec& spec) {
   devices::DeviceRequest request;
   request.name = spec.name;
   request.kind = devices::DeviceKind::kDialBox;
@@ -579,12 +519,27 @@ Result<std::unique_ptr<devices::DialBox>> makeDialBoxFromSpec(const DeviceSpec& 
     }
   }
   // The SGI box answers its reset within milliseconds; a retry with nothing on the port must not
-  // hold the frame loop for the backend's default second.
+  // hold the device thread for the backend's default second.
   if (spec.backend == DeviceBackend::kSerial) request.options["reset_timeout_ms"] = "200";
-  return makeMatchedDialBox(std::move(*provider), std::move(request), clock);
+  return request;
 }
 
 }  // namespace
+
+Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec) {
+  auto provider = providerFor(spec);
+  if (!provider) return std::unexpected(provider.error());
+  DeviceSource source;
+  source.provider = std::move(*provider);
+  if (spec.kind == DeviceKind::kCamera) {
+    source.request = cameraRequest(spec);
+  } else {
+    auto request = dialBoxRequest(spec);
+    if (!request) return std::unexpected(request.error());
+    source.request = std::move(*request);
+  }
+  return source;
+}
 
 devices::DeviceMatch deviceMatchFor(const DeviceSpec& spec) {
   devices::DeviceMatch m;
@@ -618,12 +573,8 @@ Result<std::unique_ptr<devices::DeviceProvider>> providerFor(const DeviceSpec& s
   return fail(Errc::kUnsupported, fmt::format("no {} backend", deviceBackendName(spec.backend)));
 }
 
-std::unique_ptr<devices::DialBox> makeMatchedDialBox(std::unique_ptr<devices::DeviceProvider> provider,
-                                                     devices::DeviceRequest request, const Clock& clock) {
-  return std::make_unique<MatchedDialBox>(std::move(provider), std::move(request), clock);
-}
-
-void setScriptVcrOptions(ScriptPlayerOptions& options, const Manifest& show, const Clock& clock) {
+void setScriptVcrOptions(ScriptPlayerOptions& options, const Manifest& show, const Clock& clock,
+                         devices::DeviceManager& devices) {
   options.manualClock = clock.isManual();
   for (const DeviceSpec& d : show.devices) {
     if (d.kind != DeviceKind::kCamera) continue;
@@ -631,22 +582,14 @@ void setScriptVcrOptions(ScriptPlayerOptions& options, const Manifest& show, con
     media.name = "the script's camera";
     media.kind = MediaKind::kCamera;
     media.device = d.name;
-    options.camera = [media, &show, &clock]() { return makeCameraStream(media, show, clock); };
+    options.camera = [media, spec = d, &clock, &devices]() -> Result<std::unique_ptr<TextureStream>> {
+      auto stream = std::make_unique<CameraStream>(media, spec.name, clock, [spec] { return makeDeviceSource(spec); });
+      stream->useDevices(devices);
+      return stream;
+    };
     return;
   }
   options.camera = nullptr;
-}
-
-void registerShowFactories() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    setDialBoxFactory(DeviceBackend::kHid, makeDialBoxFromSpec);
-    setDialBoxFactory(DeviceBackend::kReplay, makeDialBoxFromSpec);
-    setDialBoxFactory(DeviceBackend::kSerial, makeDialBoxFromSpec);
-    setStreamFactory(MediaKind::kMovie, makeMovieStream);
-    setStreamFactory(MediaKind::kCamera, makeCameraStream);
-    setItemFactory(EntryKind::kMovie, makeMovieItem);
-  });
 }
 
 std::optional<std::thread::id> mjpegDecodeThread(const TextureStream& stream) {

@@ -1,18 +1,18 @@
 #pragma once
 
 /// \file
-/// \brief What fills the loader's seams (kiosk/show/show_loader.h): dial boxes of the hid and replay
-/// backends, and texture streams for movies (media::MoviePlayer) and cameras (devices'
-/// VideoSources: v4l2, libcamera, synthetic, replay; MJPEG decoded by media::MjpegDecoder off the
-/// frame loop's thread). `registerShowFactories()` installs them;
-/// runShow calls it before the first show loads, and so do tests.
+/// rief The loader's factories (ShowFactories in kiosk/show/show_loader.h) for devices and
+/// media: the backends of a manifest's devices (hid, serial, replay, v4l2, libcamera, synthetic
+/// cameras), and texture streams for movies (media::MoviePlayer) and cameras (devices'
+/// VideoSources; MJPEG decoded by media::MjpegDecoder off the frame loop's thread). The program
+/// puts them into its ShowFactories where it starts (app/show_factories.cpp); tests pick the ones
+/// they need.
 ///
-/// Who keeps a device open (kiosk/show/README.md): a dial box of a show is
-/// retried by the director's DeviceSlot (its back-off, its status line); the factory's dial box
-/// only finds and opens the device once per attempt. A camera is kept by a DeviceManager of its
-/// own inside its texture stream (absent -> live -> lost -> reopening, with its back-off); the
-/// director sees it only through TextureStream::update() and describe(). One state machine per
-/// device, never two.
+/// Who keeps a device open (kiosk/show/README.md): the director's
+/// devices::DeviceManager, for dial boxes and cameras alike (absent -> live -> lost ->
+/// reopening, with its back-off, off the frame loop on the system clock). A factory only says
+/// where a device is looked for (its provider) and what is asked for (its request); a camera's
+/// texture stream finds the camera in that manager by name. One state machine per device.
 
 #include <memory>
 #include <optional>
@@ -27,9 +27,19 @@ namespace basalt::kiosk {
 
 struct ScriptPlayerOptions;
 
-/// \brief Registers the hid and replay dial box factories and the movie and camera stream
-/// factories. Idempotent; call before the first show loads.
-void registerShowFactories();
+/// \brief The stream factory for movies (MediaKind::kMovie): a media::MoviePlayer on the file,
+/// started by the stream's first update(). A missing file is an error here.
+[[nodiscard]] Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, const Manifest& show,
+                                                                     const Clock& clock);
+
+/// \brief The stream factory for cameras (MediaKind::kCamera): the manifest's device the media
+/// names, found by name in the director's devices::DeviceManager (TextureStream::useDevices).
+[[nodiscard]] Result<std::unique_ptr<TextureStream>> makeCameraStream(const MediaSpec& media, const Manifest& show,
+                                                                      const Clock& clock);
+
+/// \brief The device factory for every backend a manifest names (dial boxes and cameras): the
+/// backend the device is looked for in, and what the director's DeviceManager is asked for.
+[[nodiscard]] Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec);
 
 /// \brief For tests: the thread a camera stream's MJPEG frames are decoded on (never the frame
 /// loop's); none for other streams, cameras that deliver raw frames, and before the first JPEG.
@@ -42,19 +52,15 @@ void registerShowFactories();
 /// synthetic, or replay with the trace folder or hid-recorder file of the spec loaded.
 [[nodiscard]] Result<std::unique_ptr<devices::DeviceProvider>> providerFor(const DeviceSpec& spec);
 
-/// \brief A dial box found by a rule each time it is opened: the device that matches now, opened
-/// through its backend. Its events are passed on from the device in service(); a lost device is
-/// reported lost, and the next open() looks for it again (it may be on another node).
-[[nodiscard]] std::unique_ptr<devices::DialBox> makeMatchedDialBox(std::unique_ptr<devices::DeviceProvider> provider,
-                                                                   devices::DeviceRequest request, const Clock& clock);
-
 /// \brief The name of the texture the scripts' VCR shows (LAVA's texture.switch = video): while
 /// it exists, parts of a show whose texture source is video show it (render/renderer.cpp).
 inline constexpr std::string_view kScriptVideoTexture = render::kVideoTexture;
 
 /// \brief Sets what a script's VCR needs from the run: the show's first camera for
-/// `tv.camera = on` (none when the manifest names none) and whether to wait for frames (a
-/// ManualClock run).
-void setScriptVcrOptions(ScriptPlayerOptions& options, const Manifest& show, const Clock& clock);
+/// `tv.camera = on` (none when the manifest names none), found in `devices` (the director's:
+/// shared with a texture that shows it, requested there otherwise), and whether to wait for
+/// frames (a ManualClock run). `show`, `clock` and `devices` outlive the options.
+void setScriptVcrOptions(ScriptPlayerOptions& options, const Manifest& show, const Clock& clock,
+                         devices::DeviceManager& devices);
 
 }  // namespace basalt::kiosk

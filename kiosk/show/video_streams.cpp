@@ -9,7 +9,10 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "media/frame_picker.h"
 #include "runtime/log.h"
+#include "runtime/script/command_table.h"
+#include "runtime/script/lexer.h"
 
 namespace basalt::kiosk {
 
@@ -57,6 +60,35 @@ Result<std::pair<std::string, ZoomSpec>> parseZoomOption(std::string_view text) 
   if (name.empty()) return bad();
   return std::pair{name, zoom};
 }
+
+namespace {
+
+/// " (its parts: 'face 1', ..., 'face 6'; did you mean 'face 1'?)": what a mistyped part name
+/// could have been. Bounded: the first parts only are listed and compared.
+std::string partsHint(const runtime::Show& show, std::string_view name) {
+  constexpr std::size_t kListed = 8;
+  constexpr std::size_t kCompared = 256;
+  constexpr std::size_t kLongest = 64;
+  if (show.partCount() == 0) return " (the show has no parts yet)";
+  std::vector<std::string_view> parts;
+  std::string listed;
+  for (std::size_t i = 0; i < std::min(show.partCount(), kCompared); ++i) {
+    const std::string_view part = show.part(static_cast<runtime::PartId>(i)).name;
+    if (i < kListed) listed += fmt::format("{}'{}'", i ? ", " : "", part);
+    if (part.size() <= kLongest) parts.push_back(part);
+  }
+  if (show.partCount() > kListed) listed += fmt::format(" and {} more", show.partCount() - kListed);
+  std::string hint = fmt::format(" (its parts: {}", listed);
+  // Part names are case-sensitive: one that differs only in case is the likeliest meaning.
+  auto same =
+      std::find_if(parts.begin(), parts.end(), [&](std::string_view p) { return script::equalsIgnoreCase(p, name); });
+  std::optional<std::string_view> guess = same != parts.end() ? std::optional(*same) : std::nullopt;
+  if (!guess && name.size() <= kLongest) guess = script::closestMatch(name, parts);
+  if (guess) hint += fmt::format("; did you mean '{}'?", *guess);
+  return hint + ")";
+}
+
+}  // namespace
 
 struct VideoStreams::Stream {
   MovieStreamSpec spec;
@@ -113,8 +145,8 @@ Result<std::unique_ptr<VideoStreams>> VideoStreams::create(const std::vector<Mov
       show.texture().source = runtime::TextureSource::kVideo;  // LAVA's texture.switch = video
     } else if (!spec.zoom) {
       log::warn(kLogKiosk,
-                "movie '{}': the show has no part of that name; the movie is a texture named '{}' for later use",
-                spec.name, spec.name);
+                "movie '{}': the show has no part of that name{}; the movie is a texture named '{}' for later use",
+                spec.name, partsHint(show, spec.name), spec.name);
     } else {
       // Only the Zoom picture shows it: drawn from the decoder's planes in one pass.
       stream->texture->setPictureOnly(true);
@@ -150,18 +182,16 @@ Result<void> VideoStreams::beforeDraw(const FrameContext& frame) {
   }
   for (const auto& s : streams_) {
     media::MoviePlayer& player = *s->player;
-    FrameRef f;
-    if (const std::int64_t leader = std::exchange(s->leaderFrame, -1); follower_ && leader >= 0) {
-      // The leader's frame by its number: two decoders' timestamps need not add up alike.
-      const std::chrono::milliseconds patience = manualClock_ ? std::chrono::milliseconds(10000) : patience_;
-      media::NumberedFrame pick = player.frameNumbered(leader, frame.time, patience);
-      if (pick.outcome == media::NumberedOutcome::kCorrected) ++movieCounts_.corrected;
-      if (pick.outcome == media::NumberedOutcome::kLate) ++movieCounts_.late;
-      f = std::move(pick.frame);
-    } else {
-      if (manualClock_) player.waitForFrameDue(frame.time, std::chrono::seconds(10));
-      f = player.frameAt(frame.time);
-    }
+    // The leader's frame by its number when a follower is given one (used up: the next frame
+    // brings its own); otherwise the stream's own timeline, which waits only offline.
+    const std::int64_t leader = std::exchange(s->leaderFrame, -1);
+    media::PickedFrame pick = media::pickFrame(player, {.showTime = frame.time,
+                                                        .leaderFrame = follower_ ? leader : -1,
+                                                        .manualClock = manualClock_,
+                                                        .patience = patience_});
+    if (pick.outcome == media::FrameOutcome::kCorrected) ++movieCounts_.corrected;
+    if (pick.outcome == media::FrameOutcome::kLate) ++movieCounts_.late;
+    FrameRef f = std::move(pick.frame);
     const media::MovieState state = player.state();
     if (state != s->lastState) {
       s->lastState = state;

@@ -118,7 +118,18 @@ void StatusBoard::noteReload(bool ok, std::string outcome) {
   std::lock_guard lock(mutex_);
   ++reloads_;
   if (!ok) ++reloadFailures_;
+  if (ok) {
+    problems_.clear();
+    reloadProblem_.clear();
+  } else {
+    reloadProblem_ = "reload " + outcome + "; the previous show plays on";
+  }
   lastReload_ = std::move(outcome);
+}
+
+void StatusBoard::setProblems(std::vector<std::string> problems) {
+  std::lock_guard lock(mutex_);
+  problems_ = std::move(problems);
 }
 
 void StatusBoard::publishShow(ShowStatus status) {
@@ -216,6 +227,8 @@ StatusSnapshot StatusBoard::snapshot(WallTime now) const {
     s.reloads = reloads_;
     s.reloadFailures = reloadFailures_;
     s.lastReload = lastReload_;
+    s.problems = problems_;
+    if (!reloadProblem_.empty()) s.problems.push_back(reloadProblem_);
     s.performance = performance_;
     s.lock = lock_;
   }

@@ -115,7 +115,10 @@ struct StatusSnapshot {
   std::vector<StreamStatus> streams;
   std::int64_t reloads = 0;
   std::int64_t reloadFailures = 0;
-  std::string lastReload;               ///< the last reload's outcome
+  std::string lastReload;  ///< the last reload's outcome
+  /// Why the node is degraded whatever its devices say: the show's errors at start (it plays its
+  /// last good copy or the problem card) and a reload that failed. Empty when none.
+  std::vector<std::string> problems;
   std::vector<log::Record> logTail;     ///< recent records, oldest first
   std::vector<log::Record> lastErrors;  ///< recent warnings and errors
   std::uint64_t errorsLogged = 0;
@@ -183,7 +186,11 @@ class StatusBoard {
   void setNominalFps(double fps);
   /// \brief The frame in which a reloaded show took over.
   void noteReloadApplied(std::int64_t frame);
+  /// \brief A failed reload makes the node degraded until a reload succeeds; a successful
+  /// reload also clears the problems set by setProblems().
   void noteReload(bool ok, std::string outcome);
+  /// \brief What is wrong with the show as it started (its errors, what plays instead).
+  void setProblems(std::vector<std::string> problems);
   void publishShow(ShowStatus status);
   void publishDevices(std::vector<DeviceStatus> devices);
   void publishStreams(std::vector<StreamStatus> streams);
@@ -244,6 +251,8 @@ class StatusBoard {
   std::int64_t reloads_ = 0;                // guarded by mutex_
   std::int64_t reloadFailures_ = 0;         // guarded by mutex_
   std::string lastReload_;                  // guarded by mutex_
+  std::vector<std::string> problems_;       // guarded by mutex_
+  std::string reloadProblem_;               // guarded by mutex_
   std::function<void()> wake_;              // set before the server starts
   const Clock* showClock_ = nullptr;        // set before the server starts
   std::vector<FolderToWatch> folders_;      // set before the server starts

@@ -108,6 +108,8 @@ std::string promLabel(std::string_view text) {
 std::string jsonString(std::string_view text) { return dumpJson(Json(text), -1); }
 
 std::string_view overallState(const StatusSnapshot& s) {
+  // The show's own errors (at start, or at a failed reload) come first.
+  if (!s.problems.empty()) return "degraded";
   for (const DeviceStatus& d : s.devices) {
     // "idle": a camera no texture shows (a script may open it); nothing is wrong with it.
     if (d.state != "live" && d.state != "idle") return "degraded";
@@ -218,6 +220,7 @@ std::string healthJson(const StatusSnapshot& s) {
                        {"message", st.message}});
   }
   out["reloads"] = {{"total", s.reloads}, {"failed", s.reloadFailures}, {"last", s.lastReload}};
+  out["problems"] = s.problems;
   out["errors_logged"] = s.errorsLogged;
   Json& errors = out["last_errors"] = Json::array();
   for (const log::Record& r : s.lastErrors) {
@@ -514,6 +517,7 @@ std::string_view statusPageHtml() {
   #state.down { background: #b3261e; }
   .notice { margin: 12px 16px 0; padding: 10px 12px; border-radius: 8px; background: #3a2e12; color: #f3d49b;
             border: 1px solid #6b531c; }
+  #problems { white-space: pre-line; margin: 12px 16px 0; padding: 8px 10px; border-left: 4px solid #c27c0e; background: #3a2a0a; }
   main { padding: 12px 16px; display: grid; gap: 14px; grid-template-columns: minmax(0, 1fr); align-items: start; }
   @media (min-width: 900px) { main { grid-template-columns: repeat(2, minmax(0, 1fr)); } .wide { grid-column: 1 / -1; } }
   @media (min-width: 1400px) { main { grid-template-columns: repeat(3, minmax(0, 1fr)); } }
@@ -550,6 +554,7 @@ std::string_view statusPageHtml() {
 <p class="notice" id="controls-off" hidden>Controls are off: this show has no token. Set <code>token_file</code>
   under <code>[status]</code> in show.toml to use the buttons on this page.</p>
 <p class="notice" id="unreachable" hidden>Basalt does not answer: the figures below are the last it gave.</p>
+<p id="problems" hidden></p>
 <main>
   <section><h2>On screen</h2><img id="thumb" alt="the frame on screen now" hidden>
     <p id="snapshot-off" hidden>The snapshot is off in this show ([status] snapshot = false).</p>
@@ -647,6 +652,7 @@ async function refresh() {
   $("show").textContent = h.show.name || "Basalt";
   $("version").textContent = "Basalt " + h.build.version;
   $("state").textContent = h.state; $("state").className = h.state;
+  $("problems").hidden = !h.problems.length; $("problems").textContent = h.problems.join("\n");
   $("item").textContent = h.show.description + (h.show.next_schedule_change ? " · schedule changes " + new Date(h.show.next_schedule_change).toLocaleString() : "");
   $("fps").textContent = h.frames.per_second === null ? "–" : h.frames.per_second.toFixed(1);
   $("p99").textContent = h.frames.frame_time_ms.p99 === null ? "–" : h.frames.frame_time_ms.p99.toFixed(1);

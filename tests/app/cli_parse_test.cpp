@@ -3,11 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <vector>
 
 #include "app/commands.h"
 #include "app/options.h"
 #include "app/run_command.h"
+#include "support/test_paths.h"
 
 namespace basalt::kiosk {
 namespace {
@@ -72,6 +75,32 @@ TEST(CommandLine, BadInputSaysWhatIsWrong) {
     EXPECT_NE(r.error().message().find(c.expected), std::string::npos)
         << "got: " << r.error().message() << "\nwanted: " << c.expected;
   }
+}
+
+TEST(CommandLine, AShowFolderMeansItsShowToml) {
+  // Makes sure `basalt run DIR` plays DIR/show.toml, and that a folder without one is refused
+  // with what it holds. Example failure: a folder taken for a LAVA script and refused as neither.
+  const auto dir = test::scratchDir("cli-parse-folder");
+  std::filesystem::create_directories(dir / "show");
+  std::ofstream(dir / "show" / "show.toml") << "[show]\n";
+  const std::string folder = (dir / "show").string();
+  auto c = parse({folder});
+  ASSERT_TRUE(c) << c.error().describe();
+  EXPECT_EQ(c->manifest, dir / "show" / "show.toml");
+  EXPECT_FALSE(c->show);
+
+  std::filesystem::create_directories(dir / "bare");
+  const std::string bare = (dir / "bare").string();
+  auto none = parse({bare});
+  ASSERT_FALSE(none);
+  EXPECT_EQ(none.error().message(), "the folder " + bare +
+                                        " has no show.toml (basalt run plays a show folder's show.toml); give a show "
+                                        "manifest (show.toml) or a LAVA script (.mdl)");
+  for (const char* name : {"b.toml", "a.mdl", "notes.txt"}) std::ofstream(dir / "bare" / name) << "\n";
+  auto other = parse({bare});
+  ASSERT_FALSE(other);
+  EXPECT_NE(other.error().message().find("; it holds a.mdl, b.toml: give one of them"), std::string::npos)
+      << other.error().message();
 }
 
 TEST(CommandLine, UnknownCommandsAndOptionsAreUsageErrors) {

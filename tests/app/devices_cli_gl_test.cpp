@@ -15,6 +15,9 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
+#include "sim/raw_video.h"
 #include "support/process.h"
 #include "support/test_paths.h"
 
@@ -90,14 +93,14 @@ TEST(DevicesCli, RecordedTraceReplaysBitForBit) {
   EXPECT_TRUE(std::filesystem::exists(raw / "camera.bvraw")) << "--raw-video keeps the uncompressed format";
   r = runBasalt({"record", "--synthetic", "--fast", "--seconds", "1", "--output", trace.string()});
   EXPECT_EQ(r.exitCode, 1) << "recording over a trace must be refused";
-  EXPECT_NE(r.output.find("not empty"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("holds a finished trace"), std::string::npos) << r.output;
 
   const auto probe = runBasalt({"run", "--frames", "1", "--headless", "--snapshot", (dir / "probe.png").string()});
   if (probe.exitCode != 0) GTEST_SKIP() << "no headless EGL here: " << probe.output;
   const auto a = dir / "a.png", b = dir / "b.png", plain = dir / "plain.png";
   r = runBasalt({"run", "--frames", "90", "--headless", "--replay", trace.string(), "--snapshot", a.string()});
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  EXPECT_NE(r.output.find("replayed dial box 'dials' (live)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("replayed trace " + trace.string() + " ("), std::string::npos) << r.output;
   r = runBasalt({"run", "--frames", "90", "--headless", "--replay", trace.string(), "--snapshot", b.string()});
   ASSERT_EQ(r.exitCode, 0) << r.output;
   r = runBasalt({"run", "--frames", "30", "--headless", "--replay", raw.string()});
@@ -108,6 +111,42 @@ TEST(DevicesCli, RecordedTraceReplaysBitForBit) {
   ASSERT_FALSE(pa.empty());
   EXPECT_EQ(pa, pb) << "the same trace under the same show must give the same frame";
   EXPECT_NE(pa, pp) << "the replayed dial turn did not change the show";
+}
+
+// Makes sure `run --replay` says once, at the end, what it replayed: the trace, its devices, and
+// the input reports and video frames they played, counted here from the trace's own files.
+// Example failure: one line per device and none with the counts, or the summary printed twice.
+TEST(DevicesCli, ReplaySaysWhatItReplayedOnce) {
+  const auto dir = test::scratchDir("devices-cli-replay-report");
+  const auto trace = dir / "site.trace";
+  auto r = runBasalt({"record", "--synthetic", "--fast", "--seconds", "2", "--raw-video", "--output", trace.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  // What the trace holds: its E: lines and its video frames.
+  std::size_t reports = 0;
+  std::istringstream hid(slurp(trace / "dials.hid"));
+  for (std::string line; std::getline(hid, line);) reports += line.starts_with("E: ") ? 1u : 0u;
+  auto video = sim::RawVideoReader::open(trace / "camera.bvraw");
+  ASSERT_TRUE(video) << video.error().describe();
+  std::size_t frames = 0;
+  for (auto f = (*video)->next(); f && *f; f = (*video)->next()) ++frames;
+  ASSERT_GT(reports, 0u);
+  ASSERT_GT(frames, 0u);
+
+  const auto probe = runBasalt({"run", "--frames", "1", "--headless", "--snapshot", (dir / "probe.png").string()});
+  if (probe.exitCode != 0) GTEST_SKIP() << "no headless EGL here: " << probe.output;
+  // Once through, with time to spare: 240 frames at 60 fps are 4 s of show time.
+  r = runBasalt({"run", "--frames", "240", "--fps", "60", "--headless", "--replay", trace.string(), "--replay-once",
+                 "--snapshot", (dir / "s.png").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const std::string said = fmt::format("basalt: replayed trace {} (2.0 s recorded on ", trace.string());
+  const auto at = r.output.find(said);
+  ASSERT_NE(at, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find(said, at + 1), std::string::npos) << "said once: " << r.output;
+  EXPECT_NE(r.output.find(fmt::format("): 2 devices, {} input reports and {} video frames over 4.0 s of show time\n",
+                                      reports, frames)),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("did not play"), std::string::npos) << r.output;
 }
 
 }  // namespace

@@ -144,6 +144,27 @@ TEST(VideoCli, MovieOnAPartAndAsTheZoomPicture) {
   EXPECT_EQ(test::readImageNumber(*image, 20, 30, 160, 120), 9);
 }
 
+TEST(VideoCli, AMistypedPartNameSaysWhichPartsThereAre) {
+  std::string why;
+  if (!eglAvailable(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  const auto dir = test::scratchDir("video-cli-part-typo");
+  auto clip = test::makeNumberedClip(dir / "numbers.mkv", 5, 30, media::VideoCodec::kH264);
+  ASSERT_TRUE(clip) << clip.error().describe();
+  // The start-up cube's parts are 'face 1' to 'face 6' (LAVA's colour cube).
+  for (const auto& [typed, meant] :
+       std::vector<std::pair<std::string, std::string>>{{"fcae 2", "face 2"}, {"Face 3", "face 3"}}) {
+    const auto r = runBasalt(
+        {"run", "--frames", "3", "--movie", typed + "=" + clip->string(), "--snapshot", (dir / "s.png").string()});
+    EXPECT_EQ(r.exitCode, 0) << "a texture nobody shows is a warning, the show goes on: " << r.output;
+    EXPECT_NE(r.output.find("movie '" + typed +
+                            "': the show has no part of that name (its parts: 'face 1', 'face 2', "
+                            "'face 3', 'face 4', 'face 5', 'face 6'; did you mean '" +
+                            meant + "'?)"),
+              std::string::npos)
+        << r.output;
+  }
+}
+
 TEST(VideoCli, BadMoviesAreReportedAndTheShowGoesOn) {
   std::string why;
   if (!eglAvailable(why)) GTEST_SKIP() << "no headless EGL here: " << why;

@@ -247,7 +247,8 @@ void cameraLatency(benchmark::State& state) {
       state.SkipWithError("no headless EGL here");
       return;
     }
-    kiosk::DeviceWiring wiring(clock, [l = loop->get()] { l->wake(); });
+    BoundedQueue<Event> events(1024, [l = loop->get()] { l->wake(); });
+    kiosk::DeviceWiring wiring(clock, events);
     wiring.manager().addProvider(std::make_unique<sim::SyntheticProvider>());
     devices::DeviceRequest r;
     r.name = "camera";
@@ -332,7 +333,26 @@ double runHeadless(const std::filesystem::path& trace, std::uint64_t* cameraFram
   runtime::Show show = runtime::Show::makeDefault();
   runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
   kiosk::FrameLoop frameLoop({60, 3600}, clock, &clock, **loop, show, **output, **renderer);
+  BoundedQueue<Event> events(1024);
   std::unique_ptr<kiosk::DeviceWiring> wiring;
+  // What the show director does with a replayed trace's input, without a show: the frame's
+  // events in time order through LAVA's table, and the shuttles' motion.
+  struct Input final : kiosk::FrameParticipant {
+    BoundedQueue<Event>* events = nullptr;
+    runtime::Bindings* bindings = nullptr;
+    runtime::Show* show = nullptr;
+    std::vector<Event> batch;
+    std::vector<Event> later;
+    Nanos last{-1};
+    Result<void> beforeDraw(const kiosk::FrameContext& f) override {
+      if (!events) return {};
+      kiosk::takeDueInput(*events, f.time, batch, later);
+      for (const Event& e : batch) bindings->apply(e, *show);
+      if (last.count() >= 0 && f.time > last) bindings->advance(f.time - last, *show);
+      last = f.time;
+      return {};
+    }
+  } input;
   struct Pull final : kiosk::FrameParticipant {
     std::shared_ptr<devices::ManagedVideoStream> stream;
     std::uint64_t frames = 0;  // camera frames uploaded and drawn
@@ -351,10 +371,14 @@ double runHeadless(const std::filesystem::path& trace, std::uint64_t* cameraFram
     }
   } pull;
   if (!trace.empty()) {
-    wiring = std::make_unique<kiosk::DeviceWiring>(clock, nullptr);
+    wiring = std::make_unique<kiosk::DeviceWiring>(clock, events);
     if (!wiring->addReplay(trace, false)) return -1;
     frameLoop.addParticipant(wiring->participant());
-    frameLoop.setEvents(&wiring->events(), &bindings);
+    input.events = &events;
+    input.bindings = &bindings;
+    input.show = &show;
+    input.batch.reserve(events.capacity());
+    frameLoop.addParticipant(input);
     wiring->start(true);
     pull.stream = wiring->manager().videoStream("camera");
   }

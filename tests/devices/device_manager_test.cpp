@@ -1,10 +1,15 @@
 // The DeviceManager's hotplug state machine, driven through every transition by the synthetic
 // backends under a ManualClock: absent -> opening -> live -> lost -> reopening -> live, back-off,
 // hotplug notifications, unplug in the middle of a read, a different device replugged at the
-// same path, and a video stream that stays the same object for the renderer throughout.
+// same path, and a video stream that stays the same object for the renderer throughout. And what
+// makes it the one owner of a show's devices: a request's own backend and back-off (1 s, 2 s,
+// 4 s ... 30 s for a show's dial boxes), requests withdrawn, shared and made again under the same
+// name while others run, a restart that reopens at once, and frame taps of one request.
 // Example failures: a lost device that is never retried, or retried every frame; a replugged
 // device of another model taken although the rule asks for vendor:product; a lost camera whose
-// stale frames still reach the texture; a stream object that dangles after a reopen.
+// stale frames still reach the texture; a stream object that dangles after a reopen; a show's
+// retries at the manager's 250 ms pace; a withdrawn device left open; a name that cannot be
+// asked for again after a reload; two synthetic scripts refused as "the same device".
 
 #include <gtest/gtest.h>
 
@@ -314,6 +319,210 @@ TEST(DeviceManager, RunsOnItsOwnThreadWithTheSystemClock) {
   manager.stop();
   EXPECT_EQ(manager.status()[0].state, DeviceState::kAbsent);
   EXPECT_EQ(stream->health().state, SourceState::kWaiting);
+}
+
+/// A backend that has one dial box or none, and notes the time of every look for it.
+class CountingProvider final : public DeviceProvider {
+ public:
+  CountingProvider(const Clock& clock, std::vector<Nanos>& looks) : clock_(clock), looks_(looks) {}
+  bool present = false;
+  [[nodiscard]] std::string_view backend() const override { return "synthetic"; }
+  std::vector<DeviceCandidate> enumerate() override {
+    looks_.push_back(clock_.now());
+    if (!present) return {};
+    return {{sim::SyntheticDial::defaultInfo(), DeviceKind::kDialBox, "", ""}};
+  }
+  Result<std::unique_ptr<DialBox>> openDialBox(const DeviceCandidate& candidate, const DeviceRequest& /*request*/,
+                                               const Clock& clock) override {
+    return std::unique_ptr<DialBox>(
+        std::make_unique<sim::SyntheticDial>(candidate.info, std::vector<sim::ScriptedInput>{}, clock, false, nullptr));
+  }
+
+ private:
+  const Clock& clock_;
+  std::vector<Nanos>& looks_;
+};
+
+// Makes sure a request's own back-off is kept exactly under a ManualClock: a show's dial box that
+// is not there is looked for at 0 s, then 1, 2, 4, 8, 16 s after each failure, then every 30 s;
+// a hotplug "add" looks at once and starts the back-off over.
+// Example failure: the manager's own 250 ms back-off used for a show's dial box; a back-off that
+// keeps growing past 30 s; a hotplug that retries but leaves the back-off at 30 s.
+TEST(DeviceManager, ARequestsOwnBackoffDoublesFromOneSecondToThirty) {
+  ManualClock clock;
+  BoundedQueue<Event> events(64);
+  DeviceManager manager(clock, events);
+  std::vector<Nanos> looks;
+  auto provider = std::make_unique<CountingProvider>(clock, looks);
+  CountingProvider& knob = *provider;
+  Upkeep upkeep;
+  upkeep.backoff = Backoff{1s, 30s};
+  ASSERT_TRUE(manager.request(dialRequest("knob", {}), std::move(provider), upkeep));
+  for (Nanos t{0}; t <= 100s; t += 10ms) {
+    clock.set(t);
+    manager.step(t);
+  }
+  const std::vector<Nanos> expected{0s, 1s, 3s, 7s, 15s, 31s, 61s, 91s};
+  EXPECT_EQ(looks, expected);
+  EXPECT_EQ(manager.status().at(0).attempts, expected.size());
+  EXPECT_EQ(manager.status().at(0).nextAttempt, 121s);
+
+  // A device appears: tried at once, and a second failure waits 1 s again, not 30 s.
+  looks.clear();
+  manager.notifyHotplug({HotplugEvent::Action::kAdded, "hidraw", "/dev/hidraw7"});
+  clock.set(100s + 5ms);
+  manager.step(clock.now());
+  EXPECT_EQ(looks, std::vector<Nanos>{100s + 5ms});
+  EXPECT_EQ(manager.status().at(0).nextAttempt, 101s + 5ms);
+  knob.present = true;
+  clock.set(101s + 5ms);
+  manager.step(clock.now());
+  EXPECT_EQ(manager.status().at(0).state, DeviceState::kLive);
+}
+
+// Makes sure a withdrawn request's device is closed by the manager and its name is free at once,
+// so that a reloaded show asks for a device of the same name while the manager's thread runs;
+// a request shared by two holders stays until both gave it up.
+// Example failures: "two devices are named 'knob'" after a reload; the old device left open (or
+// still sending events); a share that closes the device under the other holder.
+TEST(DeviceManager, WithdrawnRequestsCloseAndTheirNamesAreFreeAtOnce) {
+  Rig rig;
+  rig.provider->plug(dialAt("synthetic:knob", 1, 2));
+  DeviceMatch m;
+  m.path = "synthetic:knob";
+  auto first = rig.manager.request(dialRequest("knob", m));
+  ASSERT_TRUE(first);
+  rig.run(50ms);
+  ASSERT_EQ(rig.status("knob").state, DeviceState::kLive);
+  auto shared = rig.manager.share("knob");
+  ASSERT_TRUE(shared);
+  EXPECT_EQ(*shared, *first);
+  EXPECT_FALSE(rig.manager.share("nothing"));
+
+  rig.manager.withdraw("knob");  // one holder is left: it stays
+  rig.run(50ms);
+  EXPECT_EQ(rig.status("knob").state, DeviceState::kLive);
+  rig.drainStates();
+
+  rig.manager.withdraw("knob");  // the last one: gone from the status at once
+  EXPECT_TRUE(rig.manager.status().empty());
+  auto again = rig.manager.request(dialRequest("knob", m));
+  ASSERT_TRUE(again) << "the name is free before the next step";
+  EXPECT_NE(*again, *first) << "ids are never used twice";
+  ASSERT_EQ(rig.manager.status().size(), 1u);
+  EXPECT_EQ(rig.manager.status()[0].state, DeviceState::kAbsent);
+  rig.run(200ms);
+  EXPECT_EQ(rig.status("knob").state, DeviceState::kLive) << "the old device was closed, so its path is free";
+  EXPECT_EQ(rig.status("knob").id, *again);
+  Event e;
+  bool oldEvents = false;
+  bool newEvents = false;
+  while (rig.events.pop(e)) {
+    if (e.kind != EventKind::kDialDelta) continue;
+    if (e.device == *first) oldEvents = true;  // drained before it was withdrawn
+    if (e.device == *again) newEvents = true;
+  }
+  EXPECT_FALSE(oldEvents) << "the withdrawn device still sends";
+  EXPECT_TRUE(newEvents);
+}
+
+// Makes sure a restart closes a live device and opens it again in the same step, whatever its
+// back-off, that its bindings hear it go and come back, and that it is counted once done.
+// Example failures: a restart that waits out the back-off; a restart the control server is
+// never answered for; a shuttle that keeps turning through a restart that failed.
+TEST(DeviceManager, ARestartReopensAtOnceAndIsCounted) {
+  Rig rig;
+  rig.provider->plug(dialAt("synthetic:knob", 1, 2));
+  DeviceMatch m;
+  m.path = "synthetic:knob";
+  ASSERT_TRUE(rig.manager.request(dialRequest("knob", m)));
+  rig.run(50ms);
+  ASSERT_EQ(rig.status("knob").state, DeviceState::kLive);
+  rig.drainStates();
+  EXPECT_TRUE(rig.manager.restart("knob"));
+  EXPECT_FALSE(rig.manager.restart("nothing"));
+  rig.manager.step(rig.clock.now());
+  EXPECT_EQ(rig.status("knob").state, DeviceState::kLive);
+  EXPECT_EQ(rig.status("knob").restarts, 1u);
+  EXPECT_EQ(rig.drainStates(), (std::vector<DeviceState>{DeviceState::kLost, DeviceState::kLive}));
+
+  // Gone: the restart fails at once and says why; the device is lost, and retried later.
+  rig.provider->unplug("synthetic:knob");
+  rig.manager.restart("knob");
+  rig.manager.step(rig.clock.now());
+  const DeviceStatus s = rig.status("knob");
+  EXPECT_EQ(s.restarts, 2u);
+  EXPECT_EQ(s.state, DeviceState::kLost);
+  EXPECT_NE(s.lastError.find("synthetic:knob"), std::string::npos) << s.lastError;
+  EXPECT_GT(s.nextAttempt, rig.clock.now());
+}
+
+// Makes sure a request with a backend of its own looks there only, and that two such requests
+// may each hold a device at the same path (two synthetic scripts, two replays of one file): only
+// devices found through the same backend can be the same device.
+// Example failure: a show's second synthetic dial box refused because the first holds
+// "synthetic:dial"; a request taking a device from the shared backends instead of its own.
+TEST(DeviceManager, RequestsWithABackendOfTheirOwnFindTheirDevicesThere) {
+  Rig rig;
+  rig.provider->plug(dialAt("synthetic:dial", 9, 9));  // the shared backend's
+  auto own = [](std::uint16_t vendor) {
+    return std::make_unique<sim::SyntheticProvider>(
+        std::vector<sim::SyntheticProvider::Device>{dialAt("synthetic:dial", vendor, 1)});
+  };
+  ASSERT_TRUE(rig.manager.request(dialRequest("a", {}), own(1)));
+  ASSERT_TRUE(rig.manager.request(dialRequest("b", {}), own(2)));
+  ASSERT_TRUE(rig.manager.request(dialRequest("c", {})));
+  rig.run(50ms);
+  EXPECT_EQ(rig.status("a").state, DeviceState::kLive);
+  EXPECT_EQ(rig.status("a").device.vendor, 1);
+  EXPECT_EQ(rig.status("b").state, DeviceState::kLive);
+  EXPECT_EQ(rig.status("b").device.vendor, 2);
+  EXPECT_EQ(rig.status("c").state, DeviceState::kLive);
+  EXPECT_EQ(rig.status("c").device.vendor, 9);
+}
+
+/// Counts the frames it is handed.
+struct CountingTap final : FrameTap {
+  std::atomic<int> frames{0};
+  void onFrame(DeviceId /*device*/, const FrameRef& /*frame*/) override { ++frames; }
+};
+
+// Makes sure a frame tap added for one video request sees that camera's frames and no other's,
+// and stops when it is removed; and that two readers of one stream asking for the same show time
+// both get the frame (two textures showing one camera).
+// Example failures: an MJPEG decoder fed another camera's frames; a second texture of a camera
+// that never shows a frame because the first took it.
+TEST(DeviceManager, AFrameTapSeesItsRequestsFramesOnly) {
+  Rig rig;
+  rig.provider->plug(cameraAt("synthetic:cam1"));
+  rig.provider->plug(cameraAt("synthetic:cam2"));
+  DeviceRequest one;
+  one.name = "one";
+  one.kind = DeviceKind::kVideoSource;
+  one.match.path = "synthetic:cam1";
+  DeviceRequest two = one;
+  two.name = "two";
+  two.match.path = "synthetic:cam2";
+  ASSERT_TRUE(rig.manager.request(one));
+  ASSERT_TRUE(rig.manager.request(two));
+  auto tap = std::make_shared<CountingTap>();
+  rig.manager.addFrameTap("one", tap);
+  rig.manager.addFrameTap("nothing", tap);  // no such request: nothing happens
+  rig.run(500ms);
+  const std::uint64_t delivered = rig.manager.videoSource("one")->framesDelivered();
+  EXPECT_GT(delivered, 10u);
+  EXPECT_EQ(static_cast<std::uint64_t>(tap->frames.load()), delivered) << "every frame of 'one', none of 'two'";
+  auto stream = rig.manager.videoStream("one");
+  FrameRef a = stream->frameAt(rig.clock.now());
+  FrameRef b = stream->frameAt(rig.clock.now());
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a.get(), b.get()) << "a second reader of the same show time gets the same frame";
+  a.reset();
+  b.reset();
+  rig.manager.removeFrameTap("one", tap.get());
+  const int before = tap->frames.load();
+  rig.run(200ms);
+  EXPECT_EQ(tap->frames.load(), before);
 }
 
 }  // namespace

@@ -130,7 +130,7 @@ TEST_P(HidRecordingsHardware, TheRealBackendSeesWhatTheReplayBackendGives) {
   ASSERT_EQ(expected.size(), recording.size());
 
   std::string tool = test::vlabEnv("BASALT_VLAB_HID_REPLAY").value_or("");
-  if (tool.empty()) tool = (test::binaryDir() / "sim" / "vlab" / "basalt-vlab-hid-replay").string();
+  if (tool.empty()) tool = (test::binaryDir() / "tools" / "vlab" / "basalt-vlab-hid-replay").string();
   auto replay = test::Process::start({tool, "--wait-signal", "30", "--max-gap", "0.05", "--hold", "-1", file.string()});
   ASSERT_TRUE(replay.started()) << tool;
   const std::string last = "device " + std::to_string(recording.size() - 1) + " ";

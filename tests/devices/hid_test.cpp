@@ -164,6 +164,7 @@ TEST(HidDescriptor, MalformedDescriptorsNameTheByte) {
       {{0x75, 0xff, 0x95, 0x10, 0x81, 0x02}, "Report Size"},  // 255-bit... fine size, but see next
       {{0x76, 0x00, 0x10, 0x95, 0x01, 0x81, 0x02}, "Report Size 4096"},
       {{0x29, 0x05}, "Usage Maximum without"},
+      {{0xc4}, "unknown global item 0xc4"},  // global tag 0xc is reserved; Linux refuses it too
       {{0xfe, 0x10}, "long item"},
   };
   for (const auto& c : cases) {
@@ -176,6 +177,111 @@ TEST(HidDescriptor, MalformedDescriptorsNameTheByte) {
     EXPECT_NE(r.error().describe().find(c.expect), std::string::npos) << r.error().describe();
     EXPECT_EQ(r.error().where(), "test");
   }
+}
+
+// Descriptors Linux's parser (drivers/hid/hid-core.c) accepts. Built by HID 1.11 §6.2.2: an
+// item's prefix is tag << 4 | type << 2 | size code, types main 0, global 1, local 2, reserved 3.
+// A wheel: Generic Desktop, Application collection, Usage Wheel, -127..127, 8 bits x 1, Input
+// (Data, Variable, Relative), End Collection: 19 bytes.
+const std::vector<std::uint8_t> kWheel = {0x05, 0x01, 0x09, 0x02, 0xa1, 0x01, 0x09, 0x38, 0x15, 0x81,
+                                          0x25, 0x7f, 0x75, 0x08, 0x95, 0x01, 0x81, 0x06, 0xc0};
+
+void expectOneWheel(const hid::ReportDescriptor& d) {
+  ASSERT_EQ(d.fields.size(), 1u);
+  const hid::ReportField& f = d.fields[0];
+  EXPECT_EQ(f.bitSize, 8u);
+  EXPECT_EQ(f.count, 1u);
+  EXPECT_EQ(f.logicalMin, -127);
+  EXPECT_EQ(f.logicalMax, 127);
+  ASSERT_EQ(f.usages.size(), 1u);
+  EXPECT_EQ(f.usages[0], hid::usage(0x01, 0x38));
+  ASSERT_EQ(d.collections.size(), 1u);
+  EXPECT_EQ(d.reportBytes(hid::ReportType::kInput, 0), 1u);
+}
+
+TEST(HidDescriptor, TrailingZeroPaddingIsSkippedAsLinuxDoes) {
+  // 0x00 is a main item with tag 0 (reserved) and no data; Linux skips it. Game controllers
+  // report their descriptor padded with zeros to a fixed length.
+  for (const std::size_t pads : {1u, 3u}) {
+    std::vector<std::uint8_t> desc = kWheel;
+    desc.insert(desc.end(), pads, 0x00);
+    auto r = parseReportDescriptor(desc, "padded");
+    ASSERT_TRUE(r) << r.error().describe();
+    expectOneWheel(*r);
+    ASSERT_EQ(r->ignored.size(), pads);
+    EXPECT_NE(r->ignored[0].find("byte 19"), std::string::npos) << r->ignored[0];
+    EXPECT_NE(r->ignored[0].find("0x00"), std::string::npos) << r->ignored[0];
+  }
+}
+
+TEST(HidDescriptor, ReservedMainItemEndsTheLocalState) {
+  // Like any main item, a reserved one clears the usages before it (Linux resets the local
+  // state after every main item): the wheel's usage is gone, the field stays.
+  std::vector<std::uint8_t> desc = kWheel;
+  desc.insert(desc.begin() + 8, 0x00);  // right after Usage Wheel
+  auto r = parseReportDescriptor(desc);
+  ASSERT_TRUE(r) << r.error().describe();
+  ASSERT_EQ(r->fields.size(), 1u);
+  ASSERT_EQ(r->fields[0].usages.size(), 1u);
+  EXPECT_EQ(r->fields[0].usages[0], 0u);
+  ASSERT_EQ(r->ignored.size(), 1u);
+  EXPECT_NE(r->ignored[0].find("byte 8"), std::string::npos) << r->ignored[0];
+}
+
+TEST(HidDescriptor, LongItemsAreSkippedByTheirLength) {
+  // 0xfe, data size 3, long tag 0x42, three data bytes; its data bytes would be items if the
+  // parser did not skip them (0xc0 is End Collection, 0xb4 is Pop).
+  std::vector<std::uint8_t> desc = kWheel;
+  const std::vector<std::uint8_t> longItem = {0xfe, 0x03, 0x42, 0xc0, 0xb4, 0xc0};
+  desc.insert(desc.begin() + 6, longItem.begin(), longItem.end());
+  auto r = parseReportDescriptor(desc);
+  ASSERT_TRUE(r) << r.error().describe();
+  expectOneWheel(*r);
+  ASSERT_EQ(r->ignored.size(), 1u);
+  EXPECT_NE(r->ignored[0].find("byte 6: long item with tag 0x42 and 3 data byte(s)"), std::string::npos)
+      << r->ignored[0];
+  // A long item whose data runs past the end is still an error.
+  std::vector<std::uint8_t> cut = kWheel;
+  cut.insert(cut.end(), {0xfe, 0x05, 0x01, 0x00});
+  EXPECT_FALSE(parseReportDescriptor(cut));
+}
+
+TEST(HidDescriptor, ReservedTagsAndTypeAreSkipped) {
+  // Before the wheel's Usage: local tag 0xb (reserved; 0xb0 | 2 << 2 | 1 = 0xb9), local tag 6
+  // (reserved; 0x69), an item of the reserved type (tag 1, type 3, one byte: 0x1d) and main
+  // tag 0xd (reserved; 0xd1, one byte). All four are skipped, as Linux skips them.
+  std::vector<std::uint8_t> desc = kWheel;
+  const std::vector<std::uint8_t> reserved = {0xb9, 0x07, 0x69, 0x01, 0x1d, 0x55, 0xd1, 0x00};
+  desc.insert(desc.begin() + 6, reserved.begin(), reserved.end());
+  auto r = parseReportDescriptor(desc);
+  ASSERT_TRUE(r) << r.error().describe();
+  expectOneWheel(*r);
+  ASSERT_EQ(r->ignored.size(), 4u);
+  EXPECT_NE(r->ignored[0].find("byte 6: local item 0xb9"), std::string::npos) << r->ignored[0];
+  EXPECT_NE(r->ignored[1].find("byte 8: local item 0x69"), std::string::npos) << r->ignored[1];
+  EXPECT_NE(r->ignored[2].find("byte 10: item 0x1d of the reserved type"), std::string::npos) << r->ignored[2];
+  EXPECT_NE(r->ignored[3].find("byte 12: main item 0xd1"), std::string::npos) << r->ignored[3];
+}
+
+TEST(HidDescriptor, UsageMaximumBelowItsMinimumAddsNoUsage) {
+  // Buttons 5..2: Linux adds no usage and keeps the field; so three buttons without usages.
+  const std::vector<std::uint8_t> desc = {0x05, 0x09, 0x19, 0x05, 0x29, 0x02, 0x15, 0x00,
+                                          0x25, 0x01, 0x75, 0x01, 0x95, 0x03, 0x81, 0x02};
+  auto r = parseReportDescriptor(desc);
+  ASSERT_TRUE(r) << r.error().describe();
+  ASSERT_EQ(r->fields.size(), 1u);
+  EXPECT_EQ(r->fields[0].usages, std::vector<std::uint32_t>(3, 0u));
+  ASSERT_EQ(r->ignored.size(), 1u);
+  EXPECT_NE(r->ignored[0].find("byte 4"), std::string::npos) << r->ignored[0];
+}
+
+TEST(HidDescriptor, ManySkippedItemsAreCountedNotListed) {
+  std::vector<std::uint8_t> desc = kWheel;
+  desc.insert(desc.end(), 40, 0x00);
+  auto r = parseReportDescriptor(desc);
+  ASSERT_TRUE(r) << r.error().describe();
+  ASSERT_EQ(r->ignored.size(), 17u);
+  EXPECT_EQ(r->ignored.back(), "24 more skipped item(s)");
 }
 
 TEST(HidDescriptor, FieldsGetOffsetsPerReportIdAndSignedValues) {

@@ -60,11 +60,17 @@ code, out = run(library)
 expect("ZeroMQ outside kiosk/lock fails, inside passes",
        code == 1 and "kiosk/show/s.cpp:1" in out and "kiosk/lock/f.cpp" not in out, out)
 
+cctz = tree({"kiosk/policy/p.cpp": "#include <cctz/time_zone.h>\n",
+             "kiosk/manifest/t.cpp": "#include <cctz/civil_time.h>\n"})
+code, out = run(cctz)
+expect("cctz outside kiosk/manifest fails, inside passes",
+       code == 1 and "kiosk/policy/p.cpp:1" in out and "kiosk/manifest/t.cpp" not in out, out)
+
 app_up = tree({"devices/d.cpp": '#include "app/options.h"\n'})
 code, out = run(app_up)
 expect("devices including app fails", code == 1, out)
 
 for f in failures:
     print("FAILED:", f)
-print(f"{7 - len(failures)} passed, {len(failures)} failed")
+print(f"{8 - len(failures)} passed, {len(failures)} failed")
 sys.exit(1 if failures else 0)

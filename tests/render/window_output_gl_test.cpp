@@ -94,7 +94,7 @@ class Xvfb {
 #define REQUIRE_XVFB(x)                                                                       \
   if (!(x).running()) {                                                                       \
     GTEST_SKIP() << "Xvfb is not installed or did not start (apt-get install xvfb; it is in " \
-                    "scripts/packages.txt)";                                                  \
+                    "scripts/packages-test.txt)";                                             \
   }
 
 /// Draws frame `frames` of the default show into `output` and reads it back through GL.

@@ -256,5 +256,74 @@ TEST(Traces, RawVideoRoundTripsOddSizesAndRejectsDamage) {
   EXPECT_NE(mkv.error().message().find("media/"), std::string::npos);
 }
 
+// What a trace folder may already hold when a recording starts. Makes sure a folder left by a
+// recording that never finished is replaced (it cannot be replayed: no trace.toml), while a
+// finished trace, foreign files and a recording in progress are refused with the folder named,
+// and that a discarded recording leaves nothing behind.
+// Example failure: a crashed recording's half-written files make every retry fail.
+TEST(TraceFolders, AnUnfinishedTraceIsReplacedOthersAreRefused) {
+  const auto root = test::scratchDir("trace-folders");
+  ManualClock clock(Nanos{std::chrono::seconds(1)});
+  const auto write = [](const std::filesystem::path& file) { std::ofstream(file) << "x\n"; };
+
+  // Left by a crash: recording files, its mark, no trace.toml.
+  std::filesystem::create_directories(root / "crashed.trace");
+  for (const char* name : {"dials.hid", "camera.bvraw", "camera2.mkv", ".recording"})
+    write(root / "crashed.trace" / name);
+  auto replaced = TraceRecorder::create(root / "crashed.trace", clock, {"h", "v", 60, {}});
+  ASSERT_TRUE(replaced) << replaced.error().describe();
+  EXPECT_EQ((*replaced)->replacedFiles(), (std::vector<std::string>{"camera.bvraw", "camera2.mkv", "dials.hid"}));
+  EXPECT_FALSE(std::filesystem::exists(root / "crashed.trace" / "dials.hid"));
+  EXPECT_TRUE(std::filesystem::exists(root / "crashed.trace" / ".recording")) << "the new recording's mark";
+
+  // While that recording runs, its folder is refused to a second one.
+  auto second = TraceRecorder::create(root / "crashed.trace", clock, {"h", "v", 60, {}});
+  ASSERT_FALSE(second);
+  EXPECT_NE(second.error().message().find("another 'basalt record' is writing this trace now (pid "), std::string::npos)
+      << second.error().describe();
+  EXPECT_EQ(second.error().where(), (root / "crashed.trace").string());
+  ASSERT_TRUE((*replaced)->finish());
+  EXPECT_TRUE(std::filesystem::exists(root / "crashed.trace" / "trace.toml"));
+  EXPECT_FALSE(std::filesystem::exists(root / "crashed.trace" / ".recording")) << "a finished trace has no mark";
+  replaced->reset();
+
+  // A finished trace is refused, and so is a folder with other files; both are left as they were.
+  auto finished = TraceRecorder::create(root / "crashed.trace", clock, {"h", "v", 60, {}});
+  ASSERT_FALSE(finished);
+  EXPECT_NE(finished.error().message().find("holds a finished trace"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(root / "crashed.trace" / "trace.toml"));
+  std::filesystem::create_directories(root / "photos");
+  write(root / "photos" / "b.jpg");
+  write(root / "photos" / "a.hid");
+  auto foreign = TraceRecorder::create(root / "photos", clock, {"h", "v", 60, {}});
+  ASSERT_FALSE(foreign);
+  EXPECT_NE(foreign.error().message().find("is not empty and is not a trace (it holds b.jpg)"), std::string::npos)
+      << foreign.error().message();
+  EXPECT_TRUE(std::filesystem::exists(root / "photos" / "a.hid"));
+}
+
+TEST(TraceFolders, ADiscardedRecordingLeavesNothing) {
+  const auto root = test::scratchDir("trace-discard");
+  ManualClock clock(Nanos{std::chrono::seconds(1)});
+  auto recorder = TraceRecorder::create(root / "new.trace", clock, {"h", "v", 60, {}});
+  ASSERT_TRUE(recorder) << recorder.error().describe();
+  ASSERT_TRUE((*recorder)->addDialBox(1, "dials", SyntheticDial::defaultInfo(), devices::virtualDialBoxDescriptor()));
+  (*recorder)->onReport(1, clock.now(), std::vector<std::uint8_t>(21, 0));
+  EXPECT_GT((*recorder)->bytesWritten(), 0u);
+  (*recorder)->discard();
+  EXPECT_FALSE(std::filesystem::exists(root / "new.trace")) << "the folder it made goes too";
+  EXPECT_FALSE((*recorder)->finish()) << "nothing to finish after a discard";
+  EXPECT_FALSE(std::filesystem::exists(root / "new.trace"));
+
+  // A folder that was there before (empty) stays; only the recording's files go.
+  std::filesystem::create_directories(root / "given.trace");
+  auto given = TraceRecorder::create(root / "given.trace", clock, {"h", "v", 60, {}});
+  ASSERT_TRUE(given) << given.error().describe();
+  ASSERT_TRUE((*given)->addDialBox(1, "dials", SyntheticDial::defaultInfo(), devices::virtualDialBoxDescriptor()));
+  (*given)->discard();
+  EXPECT_TRUE(std::filesystem::exists(root / "given.trace"));
+  EXPECT_TRUE(std::filesystem::is_empty(root / "given.trace"));
+}
+
 }  // namespace
 }  // namespace basalt::sim

@@ -78,7 +78,7 @@ def tool(name, package):
         for d in ("/usr/sbin", "/sbin", "/usr/bin", "/bin"):
             if os.access(os.path.join(d, name), os.X_OK):
                 return os.path.join(d, name)
-        raise LabUnavailable(f"{name} is not installed (Debian package {package}): run scripts/setup.sh")
+        raise LabUnavailable(f"{name} is not installed (Debian package {package}): run scripts/setup.sh --test")
     return path
 
 
@@ -92,7 +92,7 @@ def static_busybox():
         head = f.read(1 << 16)
     # A dynamically linked busybox (package busybox) names its interpreter; the static one does not.
     if b"/lib64/ld-linux" in head or b"ld-linux-x86-64" in head:
-        raise LabUnavailable(f"{path} is dynamically linked: install busybox-static (scripts/setup.sh)")
+        raise LabUnavailable(f"{path} is dynamically linked: install busybox-static (scripts/setup.sh --test)")
     return path
 
 

@@ -392,6 +392,11 @@ int freePortPair() {
   return 10000 + static_cast<int>(::getpid() % 1000) * 16;
 }
 
+/// The barrier's wait in the tests where a follower dies: long enough that a live follower starved
+/// of the CPU for a while (ctest -j2 beside a build on two cores) is not dropped with it, short
+/// enough that the dead one is dropped after three waits within a second.
+constexpr int kLoadedBarrierMs = 250;
+
 LockSpec leaderSpec(int port, int followers, int timeoutMs) {
   LockSpec s;
   s.role = LockRole::kLeader;
@@ -615,7 +620,7 @@ TEST(FrameLock, AKilledFollowerLeavesAndRejoinsWithoutStoppingTheOthers) {
     while (leader.frame.load() < 150) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     restarted.run(followerSpec(port, "b"));
   });
-  leader.run(leaderSpec(port, 2, 50), kFrames, std::chrono::microseconds(2000));
+  leader.run(leaderSpec(port, 2, kLoadedBarrierMs), kFrames, std::chrono::microseconds(2000));
   ta.join();
   tb.join();
   ASSERT_EQ(leader.failure, "");
@@ -895,7 +900,7 @@ TEST(FrameLock, AFollowerThatMissedCommandsCatchesUpInOrder) {
     while (leader.frame.load() < 150) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     restarted.run(followerSpec(port, "b"));
   });
-  leader.run(leaderSpec(port, 2, 50), kFrames, std::chrono::microseconds(2000));
+  leader.run(leaderSpec(port, 2, kLoadedBarrierMs), kFrames, std::chrono::microseconds(2000));
   ta.join();
   tb.join();
   ASSERT_EQ(leader.failure, "");

@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <fstream>
+#include <sstream>
 
 #include "kiosk/loop/display_views.h"
 #include "support/polyhedra.h"
@@ -98,6 +100,69 @@ TEST_F(DisplayViewsTest, CalibrationChangesLiveAndIsSavedToTheCaveFile) {
   EXPECT_EQ(reread->settings.xSkew, 0.5f);
   EXPECT_EQ(reread->settings.facet, 5u);
   EXPECT_EQ(reread->settings.model, "display.obj");
+}
+
+// Makes sure that with a folder of saved calibrations (a service's state folder: the show's folder
+// is read-only to it) a calibration is saved there and not to the show's cave file, reads back
+// alone, and is where the view starts next time, unless the cave file was changed since.
+// Example failures: a save that writes the read-only show folder (500 "Read-only file system"
+// under the unit); a saved calibration never read back, lost at the next restart; a saved file
+// that outlives an edit of the cave file and silently overrides it.
+TEST_F(DisplayViewsTest, CalibrationSavedInAStateFolderStartsTheViewNextTime) {
+  const std::filesystem::path saved = folder_ / "state/calibration";
+  const std::string caveText = "# the test cube\nmodel display.obj\nfacet[5]\n";
+  kiosk::ViewSpec one;
+  one.name = "front wall";
+  one.kind = kiosk::ViewKind::kFacet;
+  one.cave = folder_ / "display.cave";
+  {
+    auto views = kiosk::DisplayViews::create({one}, renderer(), output().size(), saved);
+    ASSERT_TRUE(views) << views.error().describe();
+    auto answer = (*views)->calibrate("front wall", "Xscale[1.25]; Yskew[-2]", true);
+    ASSERT_TRUE(answer) << answer.error().describe();
+    EXPECT_NE(answer->find("(saved to " + (saved / "front_wall.cave").string() + ")"), std::string::npos) << *answer;
+  }
+  std::ifstream caveFile(folder_ / "display.cave");
+  std::ostringstream caveNow;
+  caveNow << caveFile.rdbuf();
+  EXPECT_EQ(caveNow.str(), caveText) << "the show's cave file is untouched";
+  // The saved file is a cave file of its own: it names the geometry where it is.
+  auto alone = formats::loadCave(saved / "front_wall.cave");
+  ASSERT_TRUE(alone) << alone.error().describe();
+  EXPECT_EQ(alone->settings.facet, 5u);
+  EXPECT_EQ(alone->settings.xScale, 1.25f);
+  EXPECT_EQ(alone->settings.ySkew, -2.0f);
+  ASSERT_NE(alone->geometry, nullptr);
+  EXPECT_EQ(alone->geometry->facets.size(), 6u);
+
+  {
+    auto views = kiosk::DisplayViews::create({one}, renderer(), output().size(), saved);
+    ASSERT_TRUE(views) << views.error().describe();
+    ASSERT_NE((*views)->calibration(0), nullptr);
+    EXPECT_EQ((*views)->calibration(0)->xScale, 1.25f) << "the saved calibration is where the view starts";
+    EXPECT_EQ((*views)->calibration(0)->ySkew, -2.0f);
+    EXPECT_EQ((*views)->calibration(0)->facet, 5u);
+  }
+  // The cave file edited after the save wins.
+  std::filesystem::last_write_time(
+      folder_ / "display.cave", std::filesystem::last_write_time(saved / "front_wall.cave") + std::chrono::seconds(10));
+  {
+    auto views = kiosk::DisplayViews::create({one}, renderer(), output().size(), saved);
+    ASSERT_TRUE(views) << views.error().describe();
+    EXPECT_EQ((*views)->calibration(0)->xScale, 1.0f) << "the cave file changed after the save";
+  }
+  // Without the folder, as before: saved to the cave file.
+  {
+    auto views = kiosk::DisplayViews::create({one}, renderer(), output().size());
+    ASSERT_TRUE(views) << views.error().describe();
+    auto answer = (*views)->calibrate("", "Xscale[1.5]", true);
+    ASSERT_TRUE(answer) << answer.error().describe();
+    auto reread = formats::loadCave(folder_ / "display.cave");
+    ASSERT_TRUE(reread) << reread.error().describe();
+    EXPECT_EQ(reread->settings.xScale, 1.5f);
+  }
+  EXPECT_EQ(kiosk::DisplayViews::savedCalibrationFile("/s", "left/../eye 2"),
+            std::filesystem::path("/s/left_.._eye_2.cave"));
 }
 
 TEST_F(DisplayViewsTest, AFacetPastTheDisplayIsAClearError) {

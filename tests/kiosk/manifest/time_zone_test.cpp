@@ -1,14 +1,21 @@
 // Time zones for opening hours, read from the system's tz database: offsets and local dates
 // agree with the C library's own conversion for many instants in several zones, in both
-// hemispheres and far beyond the table's end (where the POSIX rule in the footer takes over).
+// hemispheres and far beyond the table's end (where the POSIX rule in the footer takes over), and
+// with zdump's account of every change from 2020 to 2040, to the second.
 // Example failures: opening an hour late after the change to summer time; a southern-hemisphere
-// zone with daylight-saving time inverted; a damaged TZif file read past its end.
+// zone with daylight-saving time inverted; a damaged TZif file read past its end; TZDIR ignored.
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "kiosk/manifest/time_zone.h"
@@ -102,20 +109,112 @@ TEST(TimeZone, AgreesWithTheCLibraryEverywhere) {
   ::unsetenv("TZ");
 }
 
-TEST(TimeZone, PosixRules) {
-  auto us = PosixTzRule::parse("EST5EDT,M3.2.0,M11.1.0");
-  ASSERT_TRUE(us);
-  EXPECT_EQ(us->stdOffset, -5 * 3600);
-  EXPECT_EQ(us->dstOffset, -4 * 3600);
-  auto india = PosixTzRule::parse("<+0530>-5:30");
-  ASSERT_TRUE(india);
-  EXPECT_EQ(india->stdOffset, 5 * 3600 + 30 * 60);
-  EXPECT_FALSE(india->hasDst);
-  auto julian = TimeZone::fromPosix("XXX3YYY,J60/0,J300/0");
-  ASSERT_TRUE(julian);
-  EXPECT_EQ(julian->toLocal(utc(2026, 6, 1, 12)).utcOffset, -2 * 3600);
-  for (const char* bad : {"", "E5", "EST", "EST5EDT,M13.1.0,M11.1.0", "EST5EDT,M3.2.0", "EST5EDT,M3.2.0,M11.1.0x"}) {
-    EXPECT_FALSE(PosixTzRule::parse(bad)) << bad;
+TEST(TimeZone, BerlinIn2026AsZdumpPrintsIt) {
+  // `zdump -v -c 2026,2027 Europe/Berlin` (tzdata 2025b):
+  //   Sun Mar 29 00:59:59 2026 UT = Sun Mar 29 01:59:59 2026 CET isdst=0 gmtoff=3600
+  //   Sun Mar 29 01:00:00 2026 UT = Sun Mar 29 03:00:00 2026 CEST isdst=1 gmtoff=7200
+  //   Sun Oct 25 00:59:59 2026 UT = Sun Oct 25 02:59:59 2026 CEST isdst=1 gmtoff=7200
+  //   Sun Oct 25 01:00:00 2026 UT = Sun Oct 25 02:00:00 2026 CET isdst=0 gmtoff=3600
+  // The UTC instants as seconds: `date -u -d '2026-03-29 01:00:00' +%s` and so on.
+  auto berlin = TimeZone::load("Europe/Berlin");
+  ASSERT_TRUE(berlin) << berlin.error().describe();
+  struct Row {
+    std::int64_t utc;
+    unsigned month, day;
+    int secondOfDay, offset;
+    bool dst;
+  };
+  for (const Row& row :
+       {Row{1774745999, 3, 29, 1 * 3600 + 59 * 60 + 59, 3600, false}, Row{1774746000, 3, 29, 3 * 3600, 7200, true},
+        Row{1792889999, 10, 25, 2 * 3600 + 59 * 60 + 59, 7200, true}, Row{1792890000, 10, 25, 2 * 3600, 3600, false}}) {
+    const LocalTime local = berlin->toLocal(WallTime{std::chrono::seconds(row.utc)});
+    EXPECT_EQ(local.year, 2026) << row.utc;
+    EXPECT_EQ(local.month, row.month) << row.utc;
+    EXPECT_EQ(local.day, row.day) << row.utc;
+    EXPECT_EQ(local.weekday, 6u) << row.utc << " is a Sunday";
+    EXPECT_EQ(local.secondOfDay, row.secondOfDay) << row.utc;
+    EXPECT_EQ(local.utcOffset, row.offset) << row.utc;
+    EXPECT_EQ(local.dst, row.dst) << row.utc;
+  }
+}
+
+/// What `zdump -v` prints about one instant: the second before and the second of each change.
+struct ZdumpLine {
+  std::int64_t utc = 0;
+  std::tm local{};
+  bool dst = false;
+  int offset = 0;
+};
+
+int monthIndex(const char* name) {
+  const std::string months = "JanFebMarAprMayJunJulAugSepOctNovDec";
+  const auto at = months.find(name);
+  return at == std::string::npos || std::string_view(name).size() != 3 ? -1 : static_cast<int>(at / 3);
+}
+
+/// Runs the C library's zdump (Debian's libc-bin) on `zone` for [from, to).
+std::vector<ZdumpLine> zdump(const std::string& zone, int from, int to) {
+  const std::string command = "zdump -v -c " + std::to_string(from) + "," + std::to_string(to) + " " + zone;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) {
+    ADD_FAILURE() << command << " did not start";
+    return {};
+  }
+  std::vector<ZdumpLine> lines;
+  char text[512];
+  while (std::fgets(text, sizeof text, pipe)) {
+    if (std::string_view(text).find("= NULL") != std::string_view::npos) continue;  // the ends of time
+    char utMonth[8] = {};
+    char localMonth[8] = {};
+    std::tm ut{};
+    ZdumpLine line;
+    int isdst = 0;
+    const int fields = std::sscanf(
+        text, "%*s %*s %7s %d %d:%d:%d %d UT = %*s %7s %d %d:%d:%d %d %*s isdst=%d gmtoff=%d", utMonth, &ut.tm_mday,
+        &ut.tm_hour, &ut.tm_min, &ut.tm_sec, &ut.tm_year, localMonth, &line.local.tm_mday, &line.local.tm_hour,
+        &line.local.tm_min, &line.local.tm_sec, &line.local.tm_year, &isdst, &line.offset);
+    ut.tm_mon = monthIndex(utMonth);
+    line.local.tm_mon = monthIndex(localMonth);
+    if (fields != 14 || ut.tm_mon < 0 || line.local.tm_mon < 0) {
+      ADD_FAILURE() << "cannot read zdump's line: " << text;
+      continue;
+    }
+    ut.tm_year -= 1900;
+    line.utc = ::timegm(&ut);
+    line.dst = isdst != 0;
+    lines.push_back(line);
+  }
+  EXPECT_EQ(::pclose(pipe), 0) << command;
+  return lines;
+}
+
+TEST(TimeZone, EveryChangeFrom2020To2040AgreesWithZdump) {
+  // Zones whose changes are of every kind: an hour each way in both hemispheres, half an hour
+  // (Lord Howe), at odd local times (Santiago, Chatham), around Ramadan (Casablanca), none any
+  // more (Tehran), and a half-hour standard offset (St John's).
+  for (const char* name : {"Europe/Berlin", "America/New_York", "Australia/Lord_Howe", "America/Santiago",
+                           "Pacific/Chatham", "Africa/Casablanca", "Asia/Tehran", "America/St_Johns"}) {
+    auto zone = TimeZone::load(name);
+    ASSERT_TRUE(zone) << name << ": " << zone.error().describe();
+    const std::vector<ZdumpLine> lines = zdump(name, 2020, 2040);
+    if (std::string_view(name) != "Asia/Tehran") {
+      EXPECT_GE(lines.size(), 20u * 4) << name << ": too few changes";
+    }
+    int mismatches = 0;
+    for (const ZdumpLine& z : lines) {
+      const LocalTime local = zone->toLocal(WallTime{std::chrono::seconds(z.utc)});
+      const bool same = local.year == z.local.tm_year && local.month == static_cast<unsigned>(z.local.tm_mon + 1) &&
+                        local.day == static_cast<unsigned>(z.local.tm_mday) &&
+                        local.secondOfDay == z.local.tm_hour * 3600 + z.local.tm_min * 60 + z.local.tm_sec &&
+                        local.utcOffset == z.offset && local.dst == z.dst;
+      if (!same && ++mismatches <= 3) {
+        ADD_FAILURE() << name << " at " << z.utc << ": " << local.year << "-" << local.month << "-" << local.day
+                      << " second " << local.secondOfDay << " offset " << local.utcOffset << " dst " << local.dst
+                      << "; zdump says " << z.local.tm_year << "-" << z.local.tm_mon + 1 << "-" << z.local.tm_mday
+                      << " " << z.local.tm_hour << ":" << z.local.tm_min << ":" << z.local.tm_sec << " offset "
+                      << z.offset << " dst " << z.dst;
+      }
+    }
   }
 }
 
@@ -128,16 +227,32 @@ TEST(TimeZone, BadNamesAndDamagedFilesAreErrors) {
   EXPECT_TRUE(TimeZone::load("UTC"));
 
   std::ifstream in("/usr/share/zoneinfo/Europe/Paris", std::ios::binary);
-  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(bytes.size(), 100u);
-  // Every truncation is an error or a usable zone, never a read past the end.
+  // Damaged copies in a zone folder of their own: every truncation is an error or a usable zone,
+  // never a read past the end.
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("basalt-tzdir-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "Cut");
+  ::setenv("TZDIR", dir.c_str(), 1);
   for (std::size_t n = 0; n < bytes.size(); n += 7) {
-    const auto zone = TimeZone::fromTzif(std::span(bytes.data(), n), "cut");
+    const std::string name = "Cut/" + std::to_string(n);
+    std::ofstream(dir / name, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(n));
+    const auto zone = TimeZone::load(name);
     if (zone) (void)zone->offsetAt(0);
   }
+  // The whole copy is a usable zone: $TZDIR is where zones are read from.
+  std::filesystem::create_directories(dir / "Whole");
+  std::ofstream(dir / "Whole/Paris", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  const auto whole = TimeZone::load("Whole/Paris");
   auto wrong = bytes;
   wrong[0] = 'X';
-  const auto notTzif = TimeZone::fromTzif(wrong, "wrong");
+  std::ofstream(dir / "Wrong", std::ios::binary).write(wrong.data(), static_cast<std::streamsize>(wrong.size()));
+  const auto notTzif = TimeZone::load("Wrong");
+  ::unsetenv("TZDIR");
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(whole) << whole.error().describe();
+  EXPECT_EQ(whole->toLocal(utc(2026, 7, 1, 12)).utcOffset, 7200);
   ASSERT_FALSE(notTzif);
   EXPECT_NE(notTzif.error().message().find("reinstall the tzdata package"), std::string::npos);
 }

@@ -179,6 +179,7 @@ TEST(Supervision, ACorruptStateFileIsIgnoredWithAWarning) {
   // Damage every state file the way a torn write or an editor would.
   int damaged = 0;
   for (const auto& entry : std::filesystem::directory_iterator(manager.dir / "state")) {
+    if (!entry.is_regular_file()) continue;  // the show's last good copy (last-good/)
     std::ofstream(entry.path(), std::ios::app) << "position_ns=999999999999\n";
     ++damaged;
   }

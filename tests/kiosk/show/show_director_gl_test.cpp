@@ -62,13 +62,23 @@ class FrameRecorder final : public FrameParticipant {
   std::vector<std::size_t> lit_;
 };
 
+/// The content readers (scripts, scenes, models) and the control commands: what the director's
+/// shows here play. No movie or camera stream: a movie texture shows its fallback. Tests that
+/// play a movie item add its factory.
+ShowFactories contentReaders() {
+  ShowFactories f;
+  f.items.script = makeScriptItem;
+  f.items.scene = makeSceneItem;
+  f.items.model = makeModelItem;
+  f.commands = runControlCommand;
+  return f;
+}
+
 /// A show run headless on a ManualClock, frame by frame.
 class Harness {
  public:
   explicit Harness(const std::string& name, WallTime wallStart = WallTime{std::chrono::hours(24 * 20000)})
-      : dir_(test::scratchDir("director-" + name)), clock_(Nanos{0}, wallStart), board_(wallStart, 30) {
-    registerContentReaders();
-  }
+      : dir_(test::scratchDir("director-" + name)), clock_(Nanos{0}, wallStart), board_(wallStart, 30) {}
 
   bool open(std::string& why) {
     auto output = render::createHeadlessOutput({48, 48});
@@ -91,10 +101,11 @@ class Harness {
     Diagnostics d;
     auto m = readManifest(dir_ / "show.toml", d);
     if (!m) return ::testing::AssertionFailure() << d.format();
-    auto loaded = loadShow(std::move(*m), clock_);
+    auto loaded = loadShow(std::move(*m), clock_, factories_);
     if (!loaded) return ::testing::AssertionFailure() << loaded.error().describe();
     director_ = std::make_unique<ShowDirector>(
-        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30});
+        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30},
+        factories_);
     director_->install(std::move(*loaded), clock_.now(), std::nullopt);
     return ::testing::AssertionSuccess();
   }
@@ -120,6 +131,8 @@ class Harness {
   }
 
   ShowDirector& director() { return *director_; }
+  /// What install() loads the show with, and the director reloads it with.
+  ShowFactories& factories() { return factories_; }
   StatusBoard& board() { return board_; }
   FrameRecorder& recorder() { return recorder_; }
   runtime::Show& show() { return show_; }
@@ -133,6 +146,7 @@ class Harness {
   std::filesystem::path dir_;
   ManualClock clock_;
   StatusBoard board_;
+  ShowFactories factories_ = contentReaders();
   std::unique_ptr<render::Output> output_;
   std::unique_ptr<render::Renderer> renderer_;
   std::unique_ptr<runtime::EventLoop> loop_;
@@ -231,38 +245,66 @@ action = "none"
   EXPECT_EQ(s.devices[0].state, "live");
 }
 
+/// What the test says to the gated knobs, and what they say back.
+struct Gate {
+  std::atomic<bool> release{false};       // an open may end
+  std::atomic<bool> refuse{false};        // ... with an error
+  std::atomic<bool> unplugged{false};     // the live knob fails its next read
+  std::atomic<int> attempts{0};           // opens begun
+  std::atomic<std::thread::id> openedOn;  // the thread of the last open
+};
+
 /// A dial box whose open waits until the test lets it go (a slow enumeration, a serial port's
 /// reset wait), and says on which thread it ran.
 class GatedDialBox final : public devices::DialBox {
  public:
-  GatedDialBox() : DialBox(devices::DeviceInfo{"gated knob", "test", "", 0, 0, "", ""}, 1, 0) {}
+  explicit GatedDialBox(std::shared_ptr<Gate> gate)
+      : DialBox(devices::DeviceInfo{"gated knob", "test", "", 0, 0, "test:knob", ""}, 1, 0), gate_(std::move(gate)) {}
   ~GatedDialBox() override { close(); }
   GatedDialBox(const GatedDialBox&) = delete;
   GatedDialBox& operator=(const GatedDialBox&) = delete;
 
-  std::atomic<bool> release{false};       // the open may end
-  std::atomic<bool> refuse{false};        // ... with an error
-  std::atomic<int> attempts{0};           // opens begun
-  std::atomic<std::thread::id> openedOn;  // the thread of the last open
-
  private:
   Result<void> doOpen() override {
-    openedOn = std::this_thread::get_id();
-    ++attempts;
-    for (int i = 0; i < 1000 && !release.load(); ++i) std::this_thread::sleep_for(10ms);
-    if (refuse.load()) return fail(Errc::kNotFound, "the gated knob is not there");
+    gate_->openedOn = std::this_thread::get_id();
+    ++gate_->attempts;
+    for (int i = 0; i < 1000 && !gate_->release.load(); ++i) std::this_thread::sleep_for(10ms);
+    if (gate_->refuse.load()) return fail(Errc::kNotFound, "the gated knob is not there");
     return {};
   }
   void doClose() override {}
+  void doService(Nanos /*now*/) override {
+    if (gate_->unplugged.load()) reportLost(Error(Errc::kIo, "the gated knob was unplugged"));
+  }
+
+  std::shared_ptr<Gate> gate_;
 };
 
-// On the system clock a dial box opens on the director's device thread: a frame never waits for
-// a device enumeration or a serial port (the open below takes as long as the test wants), and a
-// device plugged in (udev) is tried at once instead of after its back-off.
+/// The backend of the gated knob: always one there, opened through the gate.
+class GatedProvider final : public devices::DeviceProvider {
+ public:
+  explicit GatedProvider(std::shared_ptr<Gate> gate) : gate_(std::move(gate)) {}
+  [[nodiscard]] std::string_view backend() const override { return "test"; }
+  std::vector<devices::DeviceCandidate> enumerate() override {
+    return {{{"gated knob", "test", "", 0, 0, "test:knob", ""}, devices::DeviceKind::kDialBox, "", ""}};
+  }
+  Result<std::unique_ptr<devices::DialBox>> openDialBox(const devices::DeviceCandidate& /*candidate*/,
+                                                        const devices::DeviceRequest& /*request*/,
+                                                        const Clock& /*clock*/) override {
+    return std::make_unique<GatedDialBox>(gate_);
+  }
+
+ private:
+  std::shared_ptr<Gate> gate_;
+};
+
+// On the system clock a dial box opens on the DeviceManager's thread: a frame never waits for a
+// device enumeration or a serial port (the open below takes as long as the test wants), a lost
+// box is retried after its back-off (1 s, then 2 s), and a device plugged in (udev) is tried at
+// once instead of after its back-off.
 // Example failures: the frame loop stuck in open(); a box used while its open still runs; a
-// replug noticed only 30 s later.
+// lost box retried every frame, or never; a replug noticed only 30 s later.
 TEST(ShowDirector, DialBoxesOpenOffTheFrameLoopAndAHotplugRetriesAtOnce) {
-  std::string why;
   auto output = render::createHeadlessOutput({32, 32});
   if (!output) GTEST_SKIP() << "no headless EGL here: " << output.error().describe();
   auto renderer = render::Renderer::create();
@@ -281,58 +323,130 @@ backend = "synthetic"
   Diagnostics d;
   auto m = readManifest(dir / "show.toml", d);
   ASSERT_TRUE(m) << d.format();
-  auto loaded = loadShow(std::move(*m), clock);
+  auto loaded = loadShow(std::move(*m), clock, ShowFactories{});
   ASSERT_TRUE(loaded) << loaded.error().describe();
   ASSERT_EQ((*loaded)->devices.size(), 1u);
-  auto gated = std::make_unique<GatedDialBox>();
-  GatedDialBox& knob = *gated;
-  (*loaded)->devices[0].dialBox = std::move(gated);
+  auto gate = std::make_shared<Gate>();
+  (*loaded)->devices[0].source.provider = std::make_unique<GatedProvider>(gate);
+  (*loaded)->devices[0].source.request.match = {};
   runtime::Show show;
   StatusBoard board(clock.wallNow(), 30);
   BoundedQueue<Event> events(64);
   {
     ShowDirector director(
-        DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, nullptr, 30});
+        DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, nullptr, 30},
+        ShowFactories{});
     const Nanos t0 = clock.now();
     director.install(std::move(*loaded), t0, std::nullopt);
-    // The show's time stands still at t0: a back-off never ends by itself.
+    // The show's time stands still at t0; the manager keeps its own time on the system clock.
     auto frame = [&](std::int64_t n) { return director.beforeDraw(FrameContext{n, t0, false}); };
     auto knobState = [&] { return board.snapshot(clock.wallNow()).devices.at(0).state; };
-
-    // The first frame starts the open and goes on; so do the next ones while it runs.
-    ASSERT_TRUE(frame(0));
-    for (int i = 0; i < 500 && knob.attempts.load() == 0; ++i) std::this_thread::sleep_for(10ms);
-    ASSERT_EQ(knob.attempts.load(), 1) << "the open began";
-    EXPECT_NE(knob.openedOn.load(), std::this_thread::get_id()) << "opened on the frame loop's thread";
-    for (std::int64_t n = 1; n <= 5; ++n) ASSERT_TRUE(frame(n)) << "frames go on while the open runs";
-    EXPECT_FALSE(knob.release.load());
-    EXPECT_NE(knobState(), "live");
-    knob.release = true;
-    for (int i = 0; i < 500 && knobState() != "live"; ++i) {
-      ASSERT_TRUE(frame(6));
-      std::this_thread::sleep_for(10ms);
-    }
-    EXPECT_EQ(knobState(), "live") << board.snapshot(clock.wallNow()).devices.at(0).message;
-
-    // Unplugged: lost, and opening it again fails. With the show's time standing still its
-    // back-off never ends, but a hotplug notice has it tried again at once.
-    knob.refuse = true;
-    knob.close();
     auto frames = [&](int count) {
       for (int i = 0; i < count; ++i) {
         ASSERT_TRUE(frame(7));
         std::this_thread::sleep_for(10ms);
       }
     };
-    frames(30);
-    const int settled = knob.attempts.load();
-    ASSERT_GE(settled, 2) << "a lost box is opened again";
-    frames(30);
-    EXPECT_EQ(knob.attempts.load(), settled) << "no retry before the back-off ends";
+
+    // The open starts off the frame loop; the frames go on while it runs.
+    ASSERT_TRUE(frame(0));
+    for (int i = 0; i < 500 && gate->attempts.load() == 0; ++i) std::this_thread::sleep_for(10ms);
+    ASSERT_EQ(gate->attempts.load(), 1) << "the open began";
+    EXPECT_NE(gate->openedOn.load(), std::this_thread::get_id()) << "opened on the frame loop's thread";
+    for (std::int64_t n = 1; n <= 5; ++n) ASSERT_TRUE(frame(n)) << "frames go on while the open runs";
+    EXPECT_FALSE(gate->release.load());
+    EXPECT_NE(knobState(), "live");
+    gate->release = true;
+    for (int i = 0; i < 500 && knobState() != "live"; ++i) {
+      ASSERT_TRUE(frame(6));
+      std::this_thread::sleep_for(10ms);
+    }
+    EXPECT_EQ(knobState(), "live") << board.snapshot(clock.wallNow()).devices.at(0).message;
+
+    // Unplugged: lost, and opening it again fails. The first retry comes after 1 s, the next
+    // one not before 2 s more; a hotplug notice has it tried again at once.
+    gate->refuse = true;
+    gate->unplugged = true;
+    for (int i = 0; i < 300 && knobState() == "live"; ++i) frames(1);
+    EXPECT_EQ(knobState(), "lost");
+    for (int i = 0; i < 300 && gate->attempts.load() < 2; ++i) frames(1);
+    const int settled = gate->attempts.load();
+    ASSERT_EQ(settled, 2) << "a lost box is opened again after its back-off";
+    frames(50);
+    EXPECT_EQ(gate->attempts.load(), settled) << "no retry before the back-off ends";
+    EXPECT_NE(board.snapshot(clock.wallNow()).devices.at(0).message.find("the gated knob is not there"),
+              std::string::npos)
+        << "the status says why";
     director.noteHotplug();
-    for (int i = 0; i < 500 && knob.attempts.load() == settled; ++i) frames(1);
-    EXPECT_EQ(knob.attempts.load(), settled + 1) << "a hotplug notice retries at once";
-  }  // the director ends with an open running: it waits for it, never uses the box meanwhile
+    for (int i = 0; i < 500 && gate->attempts.load() == settled; ++i) frames(1);
+    EXPECT_EQ(gate->attempts.load(), settled + 1) << "a hotplug notice retries at once";
+  }  // the director ends with its devices: the manager's thread first, then every box closed
+}
+
+/// A backend with no dial box in it, which notes the show time of every look for one.
+class EmptyProvider final : public devices::DeviceProvider {
+ public:
+  EmptyProvider(const Clock& clock, std::shared_ptr<std::vector<Nanos>> looks)
+      : clock_(clock), looks_(std::move(looks)) {}
+  [[nodiscard]] std::string_view backend() const override { return "test"; }
+  std::vector<devices::DeviceCandidate> enumerate() override {
+    looks_->push_back(clock_.now());
+    return {};
+  }
+
+ private:
+  const Clock& clock_;
+  std::shared_ptr<std::vector<Nanos>> looks_;
+};
+
+// Makes sure a show's dial box that is not there is retried as it always was, now by the
+// DeviceManager: under a ManualClock at the first frame, then 1 s, 2 s, 4 s, 8 s, 16 s after each
+// failure and every 30 s after that, and that its status row says since when it is absent and why.
+// Example failures: the manager's own 250 ms back-off for a show's knob (a hidapi enumeration
+// four times a second); a retry per frame; a status row without the reason.
+TEST(ShowDirector, AMissingDialBoxIsRetriedAfterOneTwoFourSecondsUpToThirty) {
+  auto output = render::createHeadlessOutput({32, 32});
+  if (!output) GTEST_SKIP() << "no headless EGL here: " << output.error().describe();
+  auto renderer = render::Renderer::create();
+  ASSERT_TRUE(renderer);
+  const WallTime wallStart{std::chrono::hours(24 * 20000)};
+  ManualClock clock(Nanos{0}, wallStart);
+  auto loop = runtime::EventLoop::create(clock);
+  ASSERT_TRUE(loop);
+  const auto dir = test::scratchDir("director-backoff");
+  std::ofstream(dir / "show.toml") << R"(
+[show]
+entry = "default"
+[devices.knob]
+kind = "dial_box"
+backend = "synthetic"
+)";
+  Diagnostics d;
+  auto m = readManifest(dir / "show.toml", d);
+  ASSERT_TRUE(m) << d.format();
+  auto loaded = loadShow(std::move(*m), clock, ShowFactories{});
+  ASSERT_TRUE(loaded) << loaded.error().describe();
+  auto looks = std::make_shared<std::vector<Nanos>>();
+  (*loaded)->devices[0].source.provider = std::make_unique<EmptyProvider>(clock, looks);
+  (*loaded)->devices[0].source.request.match = {};
+  runtime::Show show;
+  StatusBoard board(wallStart, 10);
+  BoundedQueue<Event> events(64);
+  ShowDirector director(DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, nullptr, 10},
+                        ShowFactories{});
+  director.install(std::move(*loaded), clock.now(), std::nullopt);
+  for (std::int64_t n = 0; n <= 700; ++n) {  // 70 s at 10 frames a second
+    const Nanos t = frameTime(n, 10);
+    clock.set(t);
+    ASSERT_TRUE(director.beforeDraw(FrameContext{n, t, false}));
+  }
+  const std::vector<Nanos> expected{0s, 1s, 3s, 7s, 15s, 31s, 61s};
+  EXPECT_EQ(*looks, expected);
+  const StatusSnapshot s = board.snapshot(clock.wallNow());
+  ASSERT_EQ(s.devices.size(), 1u);
+  EXPECT_EQ(s.devices[0].state, "absent");
+  EXPECT_NE(s.devices[0].message.find("is plugged in"), std::string::npos) << s.devices[0].message;
+  EXPECT_EQ(s.devices[0].since, wallStart) << "absent since the show started";
 }
 
 /// How far apart two shows' placements are (Frobenius norm of the difference): unchanged by the
@@ -614,13 +728,13 @@ struct Clip {
 };
 
 TEST(ShowDirector, AMovieItemPlaysLetterboxedAndTheListMovesOnAtItsEnd) {
-  setItemFactory(EntryKind::kMovie, makeMovieItem);
   Clip clip;
   auto info = media::probeMovie(clip.file);
   ASSERT_TRUE(info) << info.error().describe();
   ASSERT_GT(info->width, info->height) << "the test expects a landscape clip";
   ASSERT_GT(info->duration, Nanos{0});
   Harness h("movie-item");
+  h.factories().items.movie = makeMovieItem;
   OPEN_OR_SKIP(h);
   std::filesystem::copy_file(clip.file, h.dir() / "clip.webm");
   ASSERT_TRUE(h.install(R"(
@@ -659,11 +773,11 @@ duration = "1h"
 }
 
 TEST(ShowDirector, AMovieAloneInItsListLoopsWithoutAGap) {
-  setItemFactory(EntryKind::kMovie, makeMovieItem);
   Clip clip;
   auto info = media::probeMovie(clip.file);
   ASSERT_TRUE(info) << info.error().describe();
   Harness h("movie-loop");
+  h.factories().items.movie = makeMovieItem;
   OPEN_OR_SKIP(h);
   std::filesystem::copy_file(clip.file, h.dir() / "clip.webm");
   ASSERT_TRUE(h.install("[show]\nentry = \"clip.webm\"\n"));
@@ -676,8 +790,8 @@ TEST(ShowDirector, AMovieAloneInItsListLoopsWithoutAGap) {
 }
 
 TEST(ShowDirector, AMovieItemThatCannotPlayIsReportedWithItsLine) {
-  setItemFactory(EntryKind::kMovie, makeMovieItem);
   Harness h("movie-broken");
+  h.factories().items.movie = makeMovieItem;
   OPEN_OR_SKIP(h);
   std::ofstream(h.dir() / "clip.webm") << "not a movie";
   ASSERT_TRUE(h.install(R"(

@@ -3,11 +3,13 @@
 // plays its movie on its texture; the camera-sculpture example, with its V4L2 camera swapped for
 // the synthetic one (no V4L2 device exists here, and the test says so) and its PowerMate for a
 // replayed recording, shows the live camera; a replayed dial box turns the show through its
-// binding; a dial box that is not plugged in shows in the status with its reason and the show
-// goes on; the scripts' VCR loads, plays, pauses, steps and rewinds a real clip from
+// binding; a replayed trace (`--replay`) and the show's own dial box deliver through the one
+// queue the director drains; a dial box that is not plugged in shows in the status with its
+// reason and the show goes on; the scripts' VCR loads, plays, pauses, steps and rewinds a real clip from
 // ../shared/testdata/video; a camera's on_loss picture (its last frame, a test pattern, a colour,
 // or the fallback image) shows while the synthetic camera is unplugged and the live picture
-// comes back with it; a camera asked to mirror that cannot flip is mirrored by the renderer;
+// comes back with it, lost and reopened by the director's one DeviceManager; a camera asked to
+// mirror that cannot flip is mirrored by the renderer;
 // `basalt record`'s Matroska camera video replays frame for frame, bit for bit, at the recorded
 // microsecond; a camera delivering MJPEG (the synthetic one's JPEG-encoded colour bars) shows
 // the same picture as its raw twin, decoded on another thread than the frame loop's, and a
@@ -32,6 +34,8 @@
 
 #include "kiosk/loop/frame_loop.h"
 #include "kiosk/manifest/manifest.h"
+#include "kiosk/show/device_wiring.h"
+#include "kiosk/show/movie_item.h"
 #include "kiosk/show/readers.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/show_director.h"
@@ -55,15 +59,24 @@ namespace {
 
 using namespace std::chrono_literals;
 
+/// What `basalt run` plays shows with (app/show_factories.cpp): every reader, stream and dial box.
+ShowFactories everyFactory() {
+  ShowFactories f;
+  f.items = {makeScriptItem, makeSceneItem, makeModelItem, makeMovieItem};
+  f.movieStreams = makeMovieStream;
+  f.cameraStreams = makeCameraStream;
+  f.devices = makeDeviceSource;
+  f.commands = runControlCommand;
+  return f;
+}
+
 /// A manifest's show run headless on a ManualClock by the director.
 class Harness {
  public:
   explicit Harness(const std::string& name)
       : dir_(test::scratchDir("streams-" + name)),
         clock_(Nanos{0}, WallTime{std::chrono::hours(24 * 20000)}),
-        board_(WallTime{std::chrono::hours(24 * 20000)}, 30) {
-    registerShowFactories();
-  }
+        board_(WallTime{std::chrono::hours(24 * 20000)}, 30) {}
 
   bool open(std::string& why) {
     auto output = render::createHeadlessOutput({64, 64});
@@ -83,17 +96,20 @@ class Harness {
     Diagnostics d;
     auto m = readManifest(manifest, d);
     if (!m) return ::testing::AssertionFailure() << d.format();
-    auto loaded = loadShow(std::move(*m), clock_);
+    auto loaded = loadShow(std::move(*m), clock_, factories_);
     if (!loaded) return ::testing::AssertionFailure() << loaded.error().describe();
     director_ = std::make_unique<ShowDirector>(
-        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30});
+        DirectorContext{clock_, *loop_, show_, *renderer_, *output_, board_, events_, nullptr, nullptr, 30},
+        factories_);
     director_->install(std::move(*loaded), clock_.now(), std::nullopt);
     return ::testing::AssertionSuccess();
   }
 
   void run(std::int64_t frames) {
     FrameLoop loop({30, frames}, clock_, &clock_, *loop_, show_, *output_, *renderer_);
+    for (FrameParticipant* p : before_) loop.addParticipant(*p);
     loop.addParticipant(*director_);
+    for (FrameParticipant* p : after_) loop.addParticipant(*p);
     loop.addParticipant(capture_);
     auto stats = loop.run();
     ASSERT_TRUE(stats) << stats.error().describe();
@@ -113,6 +129,16 @@ class Harness {
   }
   StatusBoard& board() { return board_; }
   runtime::Show& show() { return show_; }
+  ShowDirector& director() { return *director_; }
+  /// The run's one event queue (the director's).
+  BoundedQueue<Event>& events() { return events_; }
+  /// Participants of every frame before and after the director (borrowed).
+  void addBefore(FrameParticipant& p) { before_.push_back(&p); }
+  void addAfter(FrameParticipant& p) { after_.push_back(&p); }
+  [[nodiscard]] std::string item() const {
+    const auto* p = director_->policy();
+    return p && p->current().item ? p->current().item->name : std::string();
+  }
   /// The last frame drawn, read back.
   [[nodiscard]] const Image& lastFrame() const { return capture_.image; }
   /// The thread the frame loop drew the last frame on.
@@ -123,12 +149,15 @@ class Harness {
   std::filesystem::path dir_;
   ManualClock clock_;
   StatusBoard board_;
+  const ShowFactories factories_ = everyFactory();
   std::unique_ptr<render::Output> output_;
   std::unique_ptr<render::Renderer> renderer_;
   std::unique_ptr<runtime::EventLoop> loop_;
   BoundedQueue<Event> events_{1024};
   runtime::Show show_;
   std::unique_ptr<ShowDirector> director_;
+  std::vector<FrameParticipant*> before_;
+  std::vector<FrameParticipant*> after_;
   struct Capture final : FrameParticipant {
     Image image;
     std::thread::id thread;
@@ -267,6 +296,74 @@ gain = 180
   EXPECT_EQ(knob->state, devices::DeviceState::kLive) << knob->message;
   h.run(75);
   EXPECT_FALSE(h.show().position().global == before) << "two turns of the replayed knob did not turn the show";
+}
+
+/// Takes what is due by each frame's time after the director drained the queue: nothing may be.
+struct LeftOver final : FrameParticipant {
+  BoundedQueue<Event>* events = nullptr;
+  std::size_t due = 0;
+  Result<void> beforeDraw(const FrameContext& frame) override {
+    due += events->drainWhile([&](const Event& e) { return e.time <= frame.time; }, [](Event) {});
+    return {};
+  }
+};
+
+// Makes sure a replayed trace (`basalt run --replay`) and the show's own dial box deliver through
+// the one queue the director drains: each frame takes every event due from both, the replay
+// turns the show through LAVA's table without counting as a visitor, and the show's dial box
+// wakes the attract loop as a visitor does.
+// Example failures: the replay's events in a queue of their own that nobody drains once the
+// frame loop stopped doing it; a replayed knob that keeps the attract loop from ever starting
+// (or wakes it); a show's dial box whose events the replay's bindings take.
+TEST(ShowStreams, AReplayedTraceAndTheShowsDialBoxDeliverThroughOneQueue) {
+  Harness h("replay-and-dial");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(recordKnob(h.dir() / "knob.trace"));  // dial 0, a tenth of a turn every 100 ms for 2 s
+  const std::string manifest = R"(
+[show]
+entry = "default"
+[devices.dials]
+kind = "dial_box"
+backend = "synthetic"
+loop = false
+script = [ { at = "1s", dial = 1, turns = 0.25 } ]
+[[kiosk.playlist]]
+name = "one"
+entry = "default"
+duration = "1h"
+[kiosk.attract]
+idle_timeout = "30s"
+items = [ { entry = "default", name = "attract" } ]
+)";
+  std::ofstream(h.dir() / "show.toml") << manifest;
+  ASSERT_TRUE(h.install(h.dir() / "show.toml"));
+  Harness still("replay-and-dial-still");
+  OPEN_OR_SKIP(still);
+  std::ofstream(still.dir() / "show.toml") << manifest;
+  ASSERT_TRUE(still.install(still.dir() / "show.toml"));
+
+  DeviceWiring replay(h.clock(), h.events(), kReplayFirstId);
+  auto ids = replay.addReplay(h.dir() / "knob.trace", false);
+  ASSERT_TRUE(ids) << ids.error().describe();
+  ASSERT_EQ(ids->size(), 1u);
+  EXPECT_GE(ids->front(), kReplayFirstId);
+  runtime::Bindings lava = runtime::Bindings::lavaDefaults();
+  h.director().setReplayInput(&lava, *ids);
+  h.addBefore(replay.participant());  // the replay's manager is stepped before the director drains
+  LeftOver left;
+  left.events = &h.events();
+  h.addAfter(left);
+  replay.start(true);
+
+  h.run(27);  // 0.9 s: nine replayed turns, none of the show's dial box yet
+  still.run(27);
+  EXPECT_EQ(h.item(), "attract") << "a replayed trace is not a visitor";
+  EXPECT_FALSE(h.show().position().global == still.show().position().global) << "the replayed turns turned the show";
+  h.run(9);  // 1.2 s: the show's own dial box turned at 1 s
+  EXPECT_EQ(h.item(), "one") << "the show's dial box is a visitor";
+  h.run(30);
+  EXPECT_EQ(left.due, 0u) << "every frame took every event due from both devices";
+  replay.stop();
 }
 
 TEST(ShowStreams, AMissingDialBoxShowsInTheStatusWithItsReason) {
@@ -443,7 +540,6 @@ std::size_t orangePixels(const Image& image) {
 /// The camera-sculpture example with a synthetic camera unplugged 0.4 s after each open, the
 /// camera's media showing `onLoss` while it is gone.
 ::testing::AssertionResult installLossShow(Harness& h, const std::string& onLoss, bool mirror = false) {
-  registerContentReaders();  // the sculpture is a scene
   const auto example = test::sourceDir() / "configs/shows/camera-sculpture";
   for (const char* file : {"sculpture.sce", "sculpture.obj", "camera.png"}) {
     std::filesystem::copy_file(example / file, h.dir() / file, std::filesystem::copy_options::overwrite_existing);
@@ -524,6 +620,42 @@ TEST(ShowStreams, ALostCameraShowsItsOnLossColourAndComesBack) {
   EXPECT_EQ(orangePixels(h.lastFrame()), 0u) << "the live picture replaced the colour";
 }
 
+// Makes sure a camera's loss and return are the director's DeviceManager's: the camera is one
+// request there, lost and reopened under the same id (no manager of the stream's own), and the
+// texture's line reads the manager's state.
+// Example failure: a camera stream that opens the camera itself, so that the director's manager
+// never hears of it and the status of the show's devices misses it.
+TEST(ShowStreams, ACamerasLossAndReturnGoThroughTheDirectorsDeviceManager) {
+  Harness h("camera-one-manager");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(installLossShow(h, "#ff8000"));
+  const LoadedTexture* camera = h.texture("camera.png");
+  ASSERT_NE(camera, nullptr);
+  ASSERT_NE(camera->stream, nullptr) << camera->streamState;
+  auto row = [&] {
+    const auto all = h.director().devices().status();
+    EXPECT_EQ(all.size(), 1u) << "one request: the camera";
+    return all.empty() ? devices::DeviceStatus{} : all.front();
+  };
+  h.run(9);  // 0.3 s: live
+  const devices::DeviceStatus live = row();
+  ASSERT_EQ(live.state, devices::DeviceState::kLive) << live.lastError;
+  EXPECT_EQ(live.name, "camera");
+  EXPECT_EQ(live.kind, devices::DeviceKind::kVideoSource);
+  // Unplugged 0.4 s after it opened: the manager says so, and the texture's line says what it says.
+  ASSERT_TRUE(runUntil(h, [&] { return row().state == devices::DeviceState::kLost; }));
+  const devices::DeviceStatus lost = row();
+  EXPECT_EQ(lost.id, live.id);
+  EXPECT_FALSE(lost.lastError.empty());
+  h.run(1);
+  EXPECT_TRUE(says(*camera, "is lost: " + lost.lastError)) << camera->stream->describe();
+  // Reopened by the same manager, under the same id.
+  ASSERT_TRUE(runUntil(h, [&] { return row().state == devices::DeviceState::kLive; }));
+  EXPECT_EQ(row().id, live.id);
+  ASSERT_TRUE(runUntil(h, [&] { return !says(*camera, "showing"); })) << camera->stream->describe();
+  EXPECT_TRUE(camera->live);
+}
+
 TEST(ShowStreams, EveryOnLossKindShowsWhileTheCameraIsGone) {
   struct Case {
     std::string onLoss;
@@ -577,7 +709,6 @@ TEST(ShowStreams, ACameraThatCannotFlipIsMirroredByTheRenderer) {
 /// The camera-sculpture example with a synthetic camera (160x120 colour bars) delivering
 /// `format`, with `faults` (a TOML array, or empty).
 ::testing::AssertionResult installFormatShow(Harness& h, const std::string& format, const std::string& faults = "") {
-  registerContentReaders();
   const auto example = test::sourceDir() / "configs/shows/camera-sculpture";
   for (const char* file : {"sculpture.sce", "sculpture.obj", "camera.png"}) {
     std::filesystem::copy_file(example / file, h.dir() / file, std::filesystem::copy_options::overwrite_existing);

@@ -30,6 +30,7 @@
 #include "kiosk/manifest/manifest.h"
 #include "kiosk/manifest/time_zone.h"
 #include "kiosk/policy/state_store.h"
+#include "kiosk/show/movie_item.h"
 #include "kiosk/show/show_director.h"
 #include "kiosk/show/show_loader.h"
 #include "kiosk/show/stream_factories.h"
@@ -187,7 +188,6 @@ TEST(Soak, ADayOfTheDefaultShowStaysFlat) {
   if (!output) GTEST_SKIP() << "no headless EGL here: " << output.error().describe();
   auto renderer = render::Renderer::create();
   ASSERT_TRUE(renderer);
-  registerShowFactories();  // the replay dial box, the movie stream and the movie item
 
   const auto dir = test::scratchDir("soak");
   std::string why;
@@ -267,12 +267,18 @@ requests_per_second = 1000
   ASSERT_TRUE(state);
   auto server = StatusServer::start(manifest->status, board);
   ASSERT_TRUE(server) << server.error().describe();
-  auto loaded = loadShow(*manifest, clock);
+  // What the show plays: the replay dial box, the movie stream and the movie item.
+  ShowFactories factories;
+  factories.devices = makeDeviceSource;
+  factories.movieStreams = makeMovieStream;
+  factories.items.movie = makeMovieItem;
+  auto loaded = loadShow(*manifest, clock, factories);
   ASSERT_TRUE(loaded);
 
   runtime::Show show;
   ShowDirector director(
-      DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, state->get(), 0.25});
+      DirectorContext{clock, **loop, show, **renderer, **output, board, events, nullptr, state->get(), 0.25},
+      std::move(factories));
   director.install(std::move(*loaded), clock.now(), std::nullopt);
   FrameMetrics metrics(board, &events);
   ModeWatcher modes(director);

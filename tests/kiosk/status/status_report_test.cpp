@@ -199,7 +199,7 @@ std::pair<bool, std::string> promtool(const std::string& text) {
 // milliseconds; a counter without _total.
 TEST(StatusMetrics, PromtoolFindsNothingToSay) {
   if (::access("/usr/bin/promtool", X_OK) != 0) {
-    GTEST_SKIP() << "promtool is not installed (apt-get install prometheus; it is in scripts/packages.txt)";
+    GTEST_SKIP() << "promtool is not installed (apt-get install prometheus; it is in scripts/packages-test.txt)";
   }
   for (const bool leader : {true, false}) {
     const std::string text = metricsText(everything(leader), ServerCounters{});

@@ -555,7 +555,7 @@ TEST(StatusPage, ShowsWhatATechnicianLooksFor) {
   std::string why;
   if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why;
   if (::access("/usr/bin/chromium", X_OK) != 0) {
-    GTEST_SKIP() << "chromium is not installed (apt-get install chromium; it is in scripts/packages.txt)";
+    GTEST_SKIP() << "chromium is not installed (apt-get install chromium; it is in scripts/packages-test.txt)";
   }
   std::string manifest = showManifest(true);
   manifest.replace(manifest.find("Status test"), 11, "Lobby wall");

@@ -3,7 +3,7 @@
 // is really there and works, so that a real-backend test that fails in the lab fails because of
 // Basalt, not because of the lab. Outside the lab each test skips, saying so.
 //
-// External tools they use are Debian's (scripts/packages.txt): v4l2-ctl (v4l-utils) for V4L2,
+// External tools they use are Debian's (scripts/packages-test.txt): v4l2-ctl (v4l-utils) for V4L2,
 // kmscube for KMS, cam (libcamera-tools) for libcamera, so that the lab is checked by programs
 // other than Basalt's own backends.
 
@@ -535,7 +535,7 @@ TEST(LabUvc, UsbipCameraOnVhciStreams) {
   NEED_LAB();
   const std::string vhci = env("BASALT_VLAB_VHCI");
   ASSERT_FALSE(vhci.empty()) << fixtureLine("vhci");
-  const std::string program = (test::binaryDir() / "sim" / "vlab" / "basalt-vlab-uvc-camera").string();
+  const std::string program = (test::binaryDir() / "tools" / "vlab" / "basalt-vlab-uvc-camera").string();
   auto camera = test::Process::start({program, "--vhci", vhci});
   ASSERT_TRUE(camera.started()) << program;
   ASSERT_TRUE(camera.waitForOutput("plugged:", 30s)) << camera.outputSoFar();
@@ -594,7 +594,7 @@ TEST_P(LabHidReplay, RecordingReplaysThroughHidraw) {
   ASSERT_TRUE(read) << read.error().describe();
   const std::vector<sim::HidRecordedDevice>* recording = &read->devices;
   std::string tool = env("BASALT_VLAB_HID_REPLAY");
-  if (tool.empty()) tool = (test::binaryDir() / "sim" / "vlab" / "basalt-vlab-hid-replay").string();
+  if (tool.empty()) tool = (test::binaryDir() / "tools" / "vlab" / "basalt-vlab-hid-replay").string();
 
   auto replay = test::Process::start({tool, "--wait-signal", "30", "--max-gap", "0.05", "--hold", "-1", file.string()});
   ASSERT_TRUE(replay.started()) << tool;

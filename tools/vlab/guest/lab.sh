@@ -301,7 +301,7 @@ for r in 50-udev-default.rules 60-persistent-v4l.rules; do
 done
 [ -d "$udev_rules" ] && mount --bind /host/run/basalt-vlab/udev-rules "$udev_rules"
 if ! in_host "test -x /lib/systemd/systemd-udevd"; then
-  fixture_fail udev "the host has no systemd-udevd (Debian package udev; scripts/setup.sh): libcamera sees no camera without it"
+  fixture_fail udev "the host has no systemd-udevd (Debian package udev; scripts/setup.sh --test): libcamera sees no camera without it"
 elif in_host "/lib/systemd/systemd-udevd --daemon && udevadm trigger --settle --action=add --subsystem-match=video4linux --subsystem-match=media" >"$hr/udev.log" 2>&1; then
   setenv BASALT_VLAB_UDEV 1
   fixture_ok udev "systemd-udevd runs; video4linux and media devices processed"
