@@ -39,7 +39,8 @@ TEST_P(ExampleRun, PlaysHeadless) {
 INSTANTIATE_TEST_SUITE_P(Configs, ExampleRun,
                          testing::Values(std::pair{"default", "Default demo"}, std::pair{"video-wall", "Video wall"},
                                          std::pair{"camera-sculpture", "Camera sculpture"},
-                                         std::pair{"lava-script", "LAVA tour"}));
+                                         std::pair{"lava-script", "LAVA tour"}),
+                         [](const auto& p) { return test::caseName(p.param.first); });
 
 TEST(KioskRun, AShowFolderPlaysItsShowToml) {
   std::string why;

@@ -99,14 +99,6 @@ const ImageCase kImages[] = {
 };
 // clang-format on
 
-std::string caseName(const char* path) {
-  std::string name = path;
-  for (char& c : name) {
-    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-  }
-  return name;
-}
-
 TEST(TestData, Available) {
   if (basalt::test::testdataDir().empty()) {
     GTEST_SKIP() << "the shared test data (../shared/testdata) is not on this machine";
@@ -139,7 +131,7 @@ TEST_P(ImageFile, DecodesToTheExpectedShapeOrIsRejectedClearly) {
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedTestData, ImageFile, ::testing::ValuesIn(kImages),
-                         [](const auto& p) { return caseName(p.param.path); });
+                         [](const auto& p) { return test::caseName(p.param.path); });
 
 TEST(ImageFiles, EveryFileInTheSharedTexturesFolderHasACase) {
   const auto data = basalt::test::testdataDir();

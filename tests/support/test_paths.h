@@ -3,9 +3,11 @@
 /// \file
 /// \brief Where tests find the source tree, the build tree and the shared test data.
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 namespace basalt::test {
 
@@ -28,6 +30,17 @@ inline std::filesystem::path scratchDir(const std::string& name) {
   std::filesystem::remove_all(p, ec);
   std::filesystem::create_directories(p);
   return p;
+}
+
+/// \brief A GoogleTest case name made of `text` (a path, a show's folder): every character that is
+/// not a letter or a digit becomes '_'. Parameterized suites name their cases with it, and ctest
+/// lists the names as they are (gtest_discover_tests' NO_PRETTY_VALUES in tests/CMakeLists.txt).
+inline std::string caseName(std::string_view text) {
+  std::string name(text);
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
 }
 
 }  // namespace basalt::test

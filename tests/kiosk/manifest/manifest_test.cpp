@@ -111,7 +111,8 @@ TEST_P(ExampleShow, IsValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Configs, ExampleShow,
-                         testing::Values("default", "video-wall", "camera-sculpture", "lava-script", "cube-cave"));
+                         testing::Values("default", "video-wall", "camera-sculpture", "lava-script", "cube-cave"),
+                         [](const auto& p) { return test::caseName(p.param); });
 
 TEST(ExampleShows, EachHasWhatItsDescriptionSays) {
   const fs::path shows = test::sourceDir() / "configs/shows";

@@ -15,6 +15,7 @@
 
 #include "formats_test_util.h"
 #include "runtime/formats/mtl.h"
+#include "support/test_paths.h"
 
 namespace basalt::formats {
 namespace {
@@ -127,14 +128,6 @@ const ModelCase kModels[] = {
 };
 // clang-format on
 
-std::string caseName(const char* path) {
-  std::string name = path;
-  for (char& c : name) {
-    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-  }
-  return name;
-}
-
 class ModelFile : public ::testing::TestWithParam<ModelCase> {};
 
 TEST_P(ModelFile, LoadsWithTheExpectedCountsOrIsRejectedClearly) {
@@ -185,7 +178,7 @@ TEST_P(ModelFile, LoadsWithTheExpectedCountsOrIsRejectedClearly) {
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedTestData, ModelFile, ::testing::ValuesIn(kModels),
-                         [](const auto& p) { return caseName(p.param.path); });
+                         [](const auto& p) { return basalt::test::caseName(p.param.path); });
 
 struct MaterialCase {
   const char* path;
@@ -263,7 +256,7 @@ TEST_P(MaterialFile, ReadsTheExpectedMaterials) {
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedTestData, MaterialFile, ::testing::ValuesIn(kMaterials),
-                         [](const auto& p) { return caseName(p.param.path); });
+                         [](const auto& p) { return basalt::test::caseName(p.param.path); });
 
 // Every file under models/ has a case here or in image_files_test.cpp (the JPEG textures).
 TEST(ModelFiles, EveryFileInTheSharedModelsFolderHasACase) {
