@@ -27,6 +27,7 @@
 #include "runtime/clock.h"
 #include "runtime/log.h"
 #include "vlab.h"
+#include "vlab_uvc.h"
 
 namespace basalt::devices {
 namespace {
@@ -159,7 +160,7 @@ TEST(V4l2Controls, JpegQualityWithoutTheControlWarnsOncePerCamera) {
 TEST(V4l2Controls, JpegQualityIsSetWhereTheDeviceHasTheControl) {
   std::vector<std::string> candidates;
   for (const auto& [variable, node] : vividNodes()) candidates.push_back(node);
-  if (auto uvc = test::vlabEnv("BASALT_VLAB_V4L2_UVC")) candidates.push_back(*uvc);
+  if (auto uvc = test::labUvcNode()) candidates.push_back(*uvc);
   if (candidates.empty()) GTEST_SKIP() << test::needsVlab("a V4L2 camera (BASALT_VLAB_V4L2_*)");
   std::string node;
   for (const std::string& n : candidates) {

@@ -29,6 +29,7 @@
 #include "tools/vlab/uvc/usb_powermate.h"
 #include "tools/vlab/uvc/usbip.h"
 #include "vlab.h"
+#include "vlab_uvc.h"
 
 namespace basalt::devices {
 namespace {
@@ -260,7 +261,7 @@ TEST(HotplugHardware, PowerMateGadgetUnpluggedAndReplugged) {
 }
 
 TEST(HotplugHardware, UvcGadgetUnpluggedAndReplugged) {
-  const auto node = test::vlabEnv("BASALT_VLAB_V4L2_UVC");
+  const auto node = test::labUvcNode();
   if (!node || !test::vlabEnv("BASALT_VLAB_GADGET_CTL")) {
     GTEST_SKIP() << test::needsVlab("BASALT_VLAB_V4L2_UVC and BASALT_VLAB_GADGET_CTL");
   }

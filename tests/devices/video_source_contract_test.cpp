@@ -25,6 +25,7 @@
 #include "sim/synthetic_camera.h"
 #include "support/test_paths.h"
 #include "vlab.h"
+#include "vlab_uvc.h"
 
 namespace basalt::devices {
 namespace {
@@ -72,9 +73,13 @@ std::shared_ptr<VideoSource> makeReplay(const Clock& clock, std::string& reason)
 }
 
 std::shared_ptr<VideoSource> makeV4l2(const char* variable, const char* what, const Clock& clock, std::string& reason) {
-  const auto node = test::vlabEnv(variable);
+  const bool uvc = std::string(variable) == "BASALT_VLAB_V4L2_UVC";
+  const auto node = uvc ? test::labUvcNode() : test::vlabEnv(variable);
   if (!node) {
-    reason = test::needsVlab(std::string(variable) + " (" + what + ")");
+    reason = uvc && test::vlabEnv(variable)
+                 ? "the lab's UVC camera (USB 1209:0002) is at no /dev/video node: a case before unplugged it and "
+                   "it did not come back"
+                 : test::needsVlab(std::string(variable) + " (" + what + ")");
     return nullptr;
   }
   V4l2Options options;
