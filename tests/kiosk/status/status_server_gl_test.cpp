@@ -579,9 +579,17 @@ TEST(StatusPage, ShowsWhatATechnicianLooksFor) {
   EXPECT_EQ(element(d, "span", "version"), "Basalt " + number) << d;
   const std::string build = element(d, "dd", "build");
   EXPECT_TRUE(build.starts_with(number + ", revision ")) << build;
+  // The revision is a commit git knows in this checkout, and HEAD is it or descends from it (the
+  // build may predate commits made since; the build writes the revision, not the test run).
   const auto git = test::run({"/usr/bin/git", "-C", test::sourceDir().string(), "rev-parse", "--short=12", "HEAD"});
   if (git.exitCode == 0) {
-    EXPECT_NE(build.find("revision " + git.output.substr(0, 12)), std::string::npos) << build << " vs " << git.output;
+    const auto at = build.find(", revision ");
+    ASSERT_NE(at, std::string::npos) << build;
+    const std::string revision = build.substr(at + 11, 12);
+    EXPECT_EQ(revision.find_first_not_of("0123456789abcdef"), std::string::npos) << build;
+    const auto ancestor =
+        test::run({"/usr/bin/git", "-C", test::sourceDir().string(), "merge-base", "--is-ancestor", revision, "HEAD"});
+    EXPECT_EQ(ancestor.exitCode, 0) << build << " is not HEAD (" << git.output << ") nor before it";
   }
   // The machine.
   EXPECT_EQ(element(d, "dd", "hostname"), firstLineOf("/proc/sys/kernel/hostname")) << d;
