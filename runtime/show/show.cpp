@@ -247,6 +247,24 @@ Mat4 viewNormalisation(const Show& show) {
   return Mat4::scaling({scale, scale, scale}) * Mat4::translation(-center);
 }
 
+float uniformScale(const Mat4& m) {
+  const float det = m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) -
+                    m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0)) +
+                    m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0));
+  return std::cbrt(std::fabs(det));
+}
+
+float sceneScale(const Show& show) {
+  return uniformScale(show.position().global * show.position().local * viewNormalisation(show));
+}
+
+float eyeSpacingInWindowUnits(const Show& show) {
+  const StereoSettings& s = show.stereo();
+  if (s.units == Units::kWindow) return s.eyeSpacing;
+  const float scale = sceneScale(show);
+  return scale > 0 && std::isfinite(scale) ? s.eyeSpacing * scale : s.eyeSpacing;
+}
+
 ViewTransforms computeView(const Show& show, float aspect) { return computeEyeView(show, aspect, 0.0f); }
 
 ViewTransforms computeEyeView(const Show& show, float aspect, float eyeOffset) {

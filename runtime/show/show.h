@@ -278,6 +278,17 @@ ViewTransforms computeEyeView(const Show& show, float aspect, float eyeOffset);
 /// computeView() puts between the scene and the local matrix.
 Mat4 viewNormalisation(const Show& show);
 
+/// \brief The uniform scale of a transform: the cube root of its 3 x 3 determinant's magnitude
+/// (how many units of the target one unit of the source is, for similarity transforms).
+float uniformScale(const Mat4& m);
+
+/// \brief How many window units one scene unit is in the plain view: the scale of the global
+/// and local matrices and the normalisation (what `Units::kScene` lengths are multiplied by).
+float sceneScale(const Show& show);
+
+/// \brief The stereo eye spacing in window units (a scene's `eyespacing` is in scene units).
+float eyeSpacingInWindowUnits(const Show& show);
+
 /// \brief Where the floor and the fake shadow go (LAVA "Environment").
 struct FloorGeometry {
   Mat4 floor;   ///< maps the floor's square (x and z in -1..1, y = 0) into the world
