@@ -430,7 +430,7 @@ struct Renderer::Impl {
       glBindVertexArray(gpu.vltmVao());
       gpu.bindVltm(mp.firstTriangleIndex / 3);
       glDrawArraysInstanced(GL_TRIANGLES, 0, 3 * segments * segments, triangles / 3);
-    } else if (key.shading == Shading::kFacet && !gpu.provokingNormalsAreFacetNormals()) {
+    } else if (key.shading == Shading::kFacet) {
       glUniform1i(u.facetStream, 1);
       glBindVertexArray(gpu.facetVao());
       glDrawArrays(GL_TRIANGLES, static_cast<GLint>(mp.firstTriangleIndex), triangles);
