@@ -103,6 +103,8 @@ ModelCounts countModel(const LoadedModel& model);
 struct ModelImport {
   const LoadedModel* model = nullptr;
   const runtime::Material* materialState = nullptr;  ///< null: parts keep their own or the default
+  /// The state is a scene's (thesis §4.2.4, OpenGL's material): applied with applySceneMaterial.
+  bool sceneMaterial = false;
 };
 std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<ModelImport>& imports,
                                        std::vector<Diagnostic>& warnings);
@@ -111,6 +113,11 @@ std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<Mo
 /// Kd, ambient and specular as reflectance factors, Ks as the specular colour, Ns as the
 /// power, 1 - d as transparency; also the line and marker colour (as `obj_colors.part_color`).
 void applyMaterial(runtime::Show& show, runtime::PartId part, const runtime::Material& material);
+
+/// \brief A scene's material state exactly (thesis §4.2.4, E.5): applyMaterial's colour,
+/// diffuse and specular, with the ambient colour as the part's own ambient reflectance (ka 1),
+/// the emission, and the shininess as the specular power.
+void applySceneMaterial(runtime::Show& show, runtime::PartId part, const runtime::Material& material);
 
 // ---- Writing ---------------------------------------------------------------------------------
 
