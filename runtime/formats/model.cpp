@@ -199,6 +199,7 @@ struct Entry {
   const ModelObject* object = nullptr;
   const runtime::Material* materialState = nullptr;
   bool sceneMaterial = false;
+  std::string instanceOf;         // the object whose geometry an instance shares ("" = its own)
   std::int32_t parentEntry = -1;  // among entries
   std::int32_t parentNode = -1;   // a node already in the Show
   std::shared_ptr<const runtime::Mesh> mesh;
@@ -252,11 +253,13 @@ std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<Mo
         const Entry& source = entries[static_cast<std::size_t>(it->second)];
         if (source.object->mesh) {
           e.mesh = source.object->mesh;
+          e.instanceOf = source.object->name;
           break;
         }
         target = &source.object->instanceOf;
       } else if (auto node = show.findNode(*target); node && show.nodes()[*node].mesh) {
         e.mesh = show.nodes()[*node].mesh;
+        e.instanceOf = *target;
         break;
       } else {
         note(e, fmt::format("'{}' is an instance of '{}', which is not loaded; it has no geometry", e.object->name,
@@ -318,6 +321,11 @@ std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<Mo
                         : e.parentNode;
       node.local = e.object->localTransform();
       node.mesh = e.mesh;
+      if (!e.instanceOf.empty() && e.mesh) {
+        for (const runtime::MeshPart& mp : e.mesh->parts) {
+          node.partNames.push_back(mp.name == e.instanceOf ? e.object->name : e.object->name + "/" + mp.name);
+        }
+      }
       node.colorMap = e.object->colorMap;
       node.reflectionMap = e.object->reflectionMap;
       node.bumpMap = e.object->bumpMap;

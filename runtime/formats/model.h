@@ -100,6 +100,11 @@ ModelCounts countModel(const LoadedModel& model);
 /// the Show; parts without a material take `materialState` when it is given (the scene's
 /// material state in force at the import). Problems (an unknown parent, a cycle) are warnings:
 /// the object is placed at the root. Returns the node id of each object, models in order.
+///
+/// An instance (`instanceof`) shares its original's geometry but not its parts: its parts are
+/// parts of its own, named after it (the original's part named after the original becomes the
+/// instance's name, any other part `instance/part`), so that its material and attributes never
+/// repaint the original (thesis §4.2.9: instances share vertex and face data only).
 struct ModelImport {
   const LoadedModel* model = nullptr;
   const runtime::Material* materialState = nullptr;  ///< null: parts keep their own or the default

@@ -12,7 +12,10 @@ NodeId Show::addNode(SceneNode node) {
   node.partIds.clear();
   if (node.mesh) {
     node.partIds.reserve(node.mesh->parts.size());
-    for (const MeshPart& mp : node.mesh->parts) node.partIds.push_back(internPart(mp.name));
+    const bool own = node.partNames.size() == node.mesh->parts.size();
+    for (std::size_t k = 0; k < node.mesh->parts.size(); ++k) {
+      node.partIds.push_back(internPart(own ? node.partNames[k] : node.mesh->parts[k].name));
+    }
   }
   if (node.parent >= static_cast<std::int32_t>(nodes_.size())) node.parent = -1;
   nodes_.push_back(std::move(node));

@@ -163,5 +163,32 @@ TEST_F(SceneLighting, FogAtTheEyeDistanceInSceneUnits) {
   }
 }
 
+TEST_F(SceneLighting, AnInstanceKeepsItsOwnMaterialAndTheOriginalItsOwn) {
+  // egg (the -1..1 square) is imported yellow; egg2, an instance of it 3 units to the right, is
+  // imported magenta. Both are lit by one directional light along the view with no ambient and
+  // no highlight: N.L = 1, so each shows 0.2 x 0.2 (global ambient x default ambient) + its
+  // diffuse colour: egg (1.04, 1.04, 0.04) -> (1, 1, 0.04), egg2 (1, 0.04, 1).
+  // The two squares span x = -1..4, radius sqrt(2.5^2 + 1^2) = 2.69258 scene units per window
+  // unit; egg's centre (0, 0) is 1.5 to the left of the scene's centre (1.5, 0) and egg2's 1.5 to
+  // the right: 1.5 / 2.69258 = 0.557086 window units, 0.557086 x 128 = 71.3 pixels from the middle.
+  const runtime::Show show = loadShow(
+      "scene-instance",
+      "light position[0,0,1,0] ambient[0,0,0] diffuse[255,255,255] specular[0,0,0]\n"
+      "diffuse[255,255,0]\nimport egg.obj\ndiffuse[255,0,255]\nimport egg2.obj\n",
+      {{"egg.obj", quadObj("egg", -1, -1, 1, 1, 0)}, {"egg2.obj", "o egg2\ninstanceof egg\nposition 3 0 0\n"}});
+  const auto egg = show.findPart("egg");
+  const auto egg2 = show.findPart("egg2");
+  ASSERT_TRUE(egg && egg2) << "the instance has a part of its own";
+  EXPECT_NE(*egg, *egg2);
+  const Image image = renderShow(show);
+  const double offset = 1.5 / std::sqrt(2.5 * 2.5 + 1.0) * 128.0;
+  const auto left = static_cast<std::uint32_t>(std::lround(128.0 - offset));
+  const auto right = static_cast<std::uint32_t>(std::lround(128.0 + offset));
+  for (std::uint32_t dy : {110U, 146U}) {
+    expectColour(image, left, dy, 1.0, 1.0, 0.04, "the original, yellow");
+    expectColour(image, right, dy, 1.0, 0.04, 1.0, "the instance, magenta");
+  }
+}
+
 }  // namespace
 }  // namespace basalt::test

@@ -274,6 +274,32 @@ TEST(SceneFiles, AShowDescribedAndWrittenLoadsBackToTheSameLightsAndViewer) {
   EXPECT_EQ(again->models.size(), 4u) << "one import per model file the Show came from";
 }
 
+TEST(SceneFiles, AnInstanceKeepsItsOwnMaterialAndTheOriginalItsOwn) {
+  // Thesis §4.2.9: instances share "vertex and face data", each has "an independent location,
+  // orientation, and scale"; §4.3.5: "Current (last read) material properties are applied to
+  // objects when they are loaded". The egg is imported yellow, its instance magenta.
+  const auto dir = basalt::test::scratchDir("scene-instance-material");
+  std::ofstream(dir / "egg.obj") << "o egg\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(dir / "egg2.obj") << "o egg2\ninstanceof egg\nposition 3 0 0\nscale 2\n";
+  std::ofstream(dir / "s.sce") << "diffuse[255,255,0]\nimport egg.obj\ndiffuse[255,0,255]\nimport egg2.obj\n";
+  auto scene = loadScene(dir / "s.sce", test::quiet());
+  ASSERT_TRUE(scene) << scene.error().describe();
+  runtime::Show show;
+  applyScene(show, *scene);
+  const auto egg = show.findNode("egg");
+  const auto egg2 = show.findNode("egg2");
+  ASSERT_TRUE(egg && egg2);
+  EXPECT_EQ(show.nodes()[*egg].mesh, show.nodes()[*egg2].mesh) << "one mesh";
+  ASSERT_EQ(show.nodes()[*egg2].partIds.size(), 1u);
+  const runtime::PartId original = show.nodes()[*egg].partIds[0];
+  const runtime::PartId instance = show.nodes()[*egg2].partIds[0];
+  EXPECT_NE(original, instance);
+  EXPECT_EQ(show.part(instance).name, "egg2");
+  EXPECT_EQ(show.resolvedStyle(original).front.color, (runtime::Color3{1, 1, 0})) << "the original stays yellow";
+  EXPECT_EQ(show.resolvedStyle(instance).front.color, (runtime::Color3{1, 0, 1})) << "the instance is magenta";
+  EXPECT_EQ(show.worldTransform(*egg2).transformPoint({1, 0, 0}), (Vec3{5, 0, 0})) << "its own placement";
+}
+
 TEST(SceneFiles, ScaledScenesKeepTheirEyeSpacingInSceneUnits) {
   // A 0..10 square: its bounds' radius is 5 sqrt 2, so one scene unit is 1 / (5 sqrt 2) window
   // units, and eyespacing[2] puts the eyes 2 / (5 sqrt 2) = 0.282843 window units apart.
