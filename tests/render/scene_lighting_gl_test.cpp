@@ -190,5 +190,36 @@ TEST_F(SceneLighting, AnInstanceKeepsItsOwnMaterialAndTheOriginalItsOwn) {
   }
 }
 
+TEST_F(SceneLighting, EyeSpacingSeparatesTheStereoEyes) {
+  // A white quad 2 scene units in front of the scene's centre plane and a black one 2 behind it,
+  // drawn as LAVA's red/cyan anaglyph. With eyespacing[0] both eyes see the same picture, so no
+  // pixel is red without green; with eyespacing[1] the eyes part and the white quad's sides show
+  // red-only fringes (the thesis' C.3 "eyespacing[%lf] # stereo, distance between eyes").
+  const auto redOnly = [](const Image& image) {
+    int n = 0;
+    for (std::uint32_t y = 0; y < kRenderSize; ++y) {
+      for (std::uint32_t x = 0; x < kRenderSize; ++x) {
+        if (channel(image, x, y, 0) > 0.5 && channel(image, x, y, 1) < 0.5) ++n;
+      }
+    }
+    return n;
+  };
+  int fringes[2] = {0, 0};
+  for (int spacing : {0, 1}) {
+    runtime::Show show =
+        loadShow("scene-eyespacing",
+                 fmt::format("eyespacing[{}]\n"
+                             "light position[0,0,1,0] ambient[0,0,0] diffuse[0,0,0] specular[0,0,0]\n"
+                             "emission[255,255,255]\nambient[0,0,0]\ndiffuse[0,0,0]\nspecular[0,0,0]\n"
+                             "import front.obj\nemission[0,0,0]\nimport back.obj\n",
+                             spacing),
+                 {{"front.obj", quadObj("front", -1, -1, 1, 1, 2)}, {"back.obj", quadObj("back", 2, -1, 4, 1, -2)}});
+    show.global().stereo = true;
+    fringes[spacing] = redOnly(renderShow(show));
+  }
+  EXPECT_EQ(fringes[0], 0) << "eyes 0 apart see one picture";
+  EXPECT_GT(fringes[1], 50) << "eyes 1 scene unit apart see the near quad shifted";
+}
+
 }  // namespace
 }  // namespace basalt::test
