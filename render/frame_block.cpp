@@ -52,8 +52,13 @@ void fillFrameBlock(FrameBlock& block, const Show& show, const runtime::ViewTran
   put(block.depthCueScale, dc.maxScale, dc.minScale, 0, 0);
   put(block.depthCueColor, dc.useBackgroundColor ? show.global().background : dc.color);
 
+  // Scene units reach the world through the model matrix: one scene unit is `scale` world units.
+  const float scale = runtime::uniformScale(view.model);
+  const bool usableScale = scale > 0 && std::isfinite(scale);
   const runtime::Fog& fog = show.fog();
-  put(block.fog, static_cast<float>(fog.mode), fog.start, fog.end, fog.density);
+  const bool sceneFog = fog.units == runtime::Units::kScene && usableScale;
+  put(block.fog, static_cast<float>(fog.mode), sceneFog ? fog.start * scale : fog.start,
+      sceneFog ? fog.end * scale : fog.end, sceneFog ? fog.density / scale : fog.density);
   put(block.fogColor, fog.color);
   put(block.background, show.global().background);
 
@@ -61,11 +66,23 @@ void fillFrameBlock(FrameBlock& block, const Show& show, const runtime::ViewTran
   for (const runtime::Light& l : show.lights()) {
     if (!l.on) continue;
     const auto i = static_cast<std::size_t>(lights++);
-    const Vec3 d = normalize(l.direction);
-    put(block.lightColor[i], l.color.r, l.color.g, l.color.b, static_cast<float>(l.type));
-    put(block.lightPosition[i], l.position.x, l.position.y, l.position.z, l.attenuation1);
-    put(block.lightDirection[i], d.x, d.y, d.z, l.attenuation2);
+    const bool scene = l.units == runtime::Units::kScene && usableScale;
+    const Vec3 d = normalize(scene ? view.model.transformDirection(l.direction) : l.direction);
+    const Vec3 p = scene ? view.model.transformPoint(l.position) : l.position;
+    const float c2 = scene ? l.attenuation2 / scale : l.attenuation2;
+    // XGL's ambient light is all ambient; the others carry Lc into the diffuse and highlight.
+    const bool ambientType = l.type == runtime::LightType::kAmbient;
+    const runtime::Color3 diffuse = ambientType ? runtime::Color3{0, 0, 0} : l.color;
+    const runtime::Color3 ambient =
+        ambientType ? runtime::Color3{l.color.r + l.ambient.r, l.color.g + l.ambient.g, l.color.b + l.ambient.b}
+                    : l.ambient;
+    const runtime::Color3 specular = ambientType ? runtime::Color3{0, 0, 0} : (l.ownSpecular ? l.specular : l.color);
+    put(block.lightColor[i], diffuse.r, diffuse.g, diffuse.b, static_cast<float>(l.type));
+    put(block.lightPosition[i], p.x, p.y, p.z, l.attenuation1);
+    put(block.lightDirection[i], d.x, d.y, d.z, c2);
     put(block.lightSpot[i], std::cos(l.angle), l.exponent, 0, 0);
+    put(block.lightAmbient[i], ambient.r, ambient.g, ambient.b, 0);
+    put(block.lightSpecular[i], specular.r, specular.g, specular.b, 0);
   }
 
   // Clipping planes are given in the object's normalised coordinates (they turn with it):

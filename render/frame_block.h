@@ -27,9 +27,11 @@ struct FrameBlock {
   float lightPosition[32][4];
   float lightDirection[32][4];
   float lightSpot[32][4];
+  float lightAmbient[32][4];
+  float lightSpecular[32][4];
   float clipPlane[16][4];
 };
-static_assert(sizeof(FrameBlock) == 2 * 64 + 10 * 16 + 4 * 32 * 16 + 16 * 16, "std140 layout of Frame");
+static_assert(sizeof(FrameBlock) == 2 * 64 + 10 * 16 + 6 * 32 * 16 + 16 * 16, "std140 layout of Frame");
 
 /// \brief Near and far eye-space depths of a perspective or orthographic projection matrix.
 struct DepthRange {
@@ -38,8 +40,10 @@ struct DepthRange {
 };
 DepthRange depthRangeOf(const Mat4& projection);
 
-/// \brief Fills the block for one view. `viewProjection` includes any jitter; `viewport` is
-/// x, y, width, height in pixels.
+/// \brief Fills the block for one view. Lights and fog in scene units are carried into the
+/// renderer's world through `view.model` (positions and directions moved with it, distances
+/// scaled by its scale), so that they keep the meaning the scene gave them. `viewProjection` includes any jitter;
+/// `viewport` is x, y, width, height in pixels.
 void fillFrameBlock(FrameBlock& block, const runtime::Show& show, const runtime::ViewTransforms& view,
                     const Mat4& viewProjection, const float (&viewport)[4]);
 

@@ -112,14 +112,16 @@ struct SegmentVertex {
 };
 static_assert(sizeof(SegmentVertex) == 96);
 
-// Facet stream layout (see surface.vert): position, facet normal, facet colour, texcoord.
+// Facet stream layout (see surface.vert): position, facet normal, facet colour, texcoord, and
+// the point the facet is lit at.
 struct FacetVertex {
   float p[3];
   float n[3];
   std::uint8_t c[4];
   float t[2];
+  float q[3];
 };
-static_assert(sizeof(FacetVertex) == 36);
+static_assert(sizeof(FacetVertex) == 48);
 
 // VLTM per-triangle layout (see vltm.vert).
 struct VltmTriangle {
@@ -205,13 +207,6 @@ std::unique_ptr<GpuMesh> GpuMesh::upload(const std::shared_ptr<const runtime::Me
     }
     all.insert(all.end(), distinct.begin(), distinct.end());
   }
-  gpu->provokingFacetNormals_ = true;
-  for (std::size_t t = 0; t + 2 < mesh.triangles.size() && gpu->provokingFacetNormals_; t += 3) {
-    const std::uint32_t a = mesh.triangles[t], b = mesh.triangles[t + 1], c = mesh.triangles[t + 2];
-    if (a >= n || b >= n || c >= n) continue;
-    const Vec3 fn = facetNormal(mesh, normals, a, b, c);
-    gpu->provokingFacetNormals_ = dot(fn, normalize(normals[c])) > 0.99999f;
-  }
   gpu->indices_ = uploadBuffer(GL_ELEMENT_ARRAY_BUFFER, all.data(), all.size());
   glBindVertexArray(0);
   log::debug(kLogRenderMesh, "uploaded mesh {} ({} vertices, {} triangles)", mesh.id(), n, mesh.triangleCount());
@@ -226,18 +221,65 @@ GLuint GpuMesh::facetVao() {
   const std::vector<Vec3>& normals = madeNormals_.empty() ? mesh->normals : madeNormals_;
   const std::vector<Vec2>& uv = madeTexcoords_.empty() ? mesh->texcoords : madeTexcoords_;
   const std::size_t n = mesh->positions.size();
-  std::vector<FacetVertex> data(mesh->triangles.size() / 3 * 3);
-  for (std::size_t t = 0; t + 2 < mesh->triangles.size(); t += 3) {
-    const std::uint32_t a = mesh->triangles[t], b = mesh->triangles[t + 1], c = mesh->triangles[t + 2];
-    if (a >= n || b >= n || c >= n) continue;
-    const Vec3 fn = facetNormal(*mesh, normals, a, b, c);
-    const auto colour = hasColors_ ? toBytes(mesh->colors[c]) : std::array<std::uint8_t, 4>{255, 255, 255, 255};
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t v = mesh->triangles[t + static_cast<std::size_t>(k)];
-      FacetVertex& fv = data[t + static_cast<std::size_t>(k)];
+  const std::size_t triangleCount = mesh->triangles.size() / 3;
+  std::vector<FacetVertex> data(triangleCount * 3);
+  // XGL lights a facet once: every triangle of a polygon carries the polygon's first corner (the
+  // point lit, OpenGL's provoking vertex of a polygon), its normal and that corner's colour.
+  const auto emit = [&](std::size_t t, std::uint32_t lit, const Vec3& fn) {
+    const auto colour = hasColors_ ? toBytes(mesh->colors[lit]) : std::array<std::uint8_t, 4>{255, 255, 255, 255};
+    const Vec3& q = mesh->positions[lit];
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t v = mesh->triangles[3 * t + k];
       const Vec3& p = mesh->positions[v];
-      fv = {{p.x, p.y, p.z}, {fn.x, fn.y, fn.z}, {colour[0], colour[1], colour[2], colour[3]}, {uv[v].x, uv[v].y}};
+      data[3 * t + k] = {{p.x, p.y, p.z},
+                         {fn.x, fn.y, fn.z},
+                         {colour[0], colour[1], colour[2], colour[3]},
+                         {uv[v].x, uv[v].y},
+                         {q.x, q.y, q.z}};
     }
+  };
+  const auto valid = [&](std::size_t t) {
+    return mesh->triangles[3 * t] < n && mesh->triangles[3 * t + 1] < n && mesh->triangles[3 * t + 2] < n;
+  };
+  std::size_t t = 0;
+  std::size_t edge = 0;
+  for (const std::uint32_t corners : mesh->facetSizes) {
+    const std::size_t owned = corners >= 3 ? corners - 2 : 0;
+    if (t + owned > triangleCount || edge + 2 * std::size_t{corners} > mesh->edges.size()) break;
+    // The polygon's normal (Newell's, over its corners), on the side of its vertex normals.
+    Vec3 newell{};
+    Vec3 vertexSum{};
+    bool inside = true;
+    for (std::size_t i = 0; i < corners; ++i) {
+      const std::uint32_t a = mesh->edges[edge + 2 * i];
+      const std::uint32_t b = mesh->edges[edge + 2 * i + 1];
+      if (a >= n || b >= n) {
+        inside = false;
+        break;
+      }
+      const Vec3& pa = mesh->positions[a];
+      const Vec3& pb = mesh->positions[b];
+      newell += Vec3{(pa.y - pb.y) * (pa.z + pb.z), (pa.z - pb.z) * (pa.x + pb.x), (pa.x - pb.x) * (pa.y + pb.y)};
+      vertexSum += normals[a];
+    }
+    const std::uint32_t first = corners > 0 ? mesh->edges[edge] : 0;
+    for (std::size_t k = 0; k < owned; ++k, ++t) {
+      if (!valid(t)) continue;
+      const std::uint32_t a = mesh->triangles[3 * t], b = mesh->triangles[3 * t + 1], c = mesh->triangles[3 * t + 2];
+      if (!inside || length(newell) <= 1e-12f) {
+        emit(t, a, facetNormal(*mesh, normals, a, b, c));
+        continue;
+      }
+      const Vec3 unit = normalize(newell);
+      emit(t, first, dot(unit, vertexSum) < 0 ? -unit : unit);
+    }
+    edge += 2 * std::size_t{corners};
+  }
+  // Triangles no polygon owns are facets of their own, lit at their first vertex.
+  for (; t < triangleCount; ++t) {
+    if (!valid(t)) continue;
+    const std::uint32_t a = mesh->triangles[3 * t], b = mesh->triangles[3 * t + 1], c = mesh->triangles[3 * t + 2];
+    emit(t, a, facetNormal(*mesh, normals, a, b, c));
   }
   facetVao_ = gl::VertexArray::create();
   glBindVertexArray(facetVao_.id());
@@ -250,6 +292,8 @@ GLuint GpuMesh::facetVao() {
   glVertexAttribPointer(2, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(FacetVertex), byteOffset(offsetof(FacetVertex, c)));
   glEnableVertexAttribArray(3);
   glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, sizeof(FacetVertex), byteOffset(offsetof(FacetVertex, t)));
+  glEnableVertexAttribArray(4);
+  glVertexAttribPointer(4, 3, GL_FLOAT, GL_FALSE, sizeof(FacetVertex), byteOffset(offsetof(FacetVertex, q)));
   glBindVertexArray(0);
   return facetVao_.id();
 }

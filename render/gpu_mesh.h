@@ -39,9 +39,6 @@ class GpuMesh {
   [[nodiscard]] bool alive() const { return !source_.expired(); }
   [[nodiscard]] const std::vector<GpuPart>& parts() const { return parts_; }
   [[nodiscard]] bool hasColors() const { return hasColors_; }
-  /// \brief True when the last vertex of every triangle already carries the facet's normal (flat
-  /// models, the colour cube): per-facet illumination then draws the indexed stream as it is.
-  [[nodiscard]] bool provokingNormalsAreFacetNormals() const { return provokingFacetNormals_; }
   [[nodiscard]] GLuint indexedVao() const { return vao_.id(); }
   /// \brief Byte offsets into the index buffer of each index family.
   [[nodiscard]] std::size_t edgeOffset() const { return edgeOffset_; }
@@ -50,7 +47,9 @@ class GpuMesh {
   [[nodiscard]] std::size_t markerOffset() const { return markerOffset_; }
 
   /// \brief The facet stream's vertex array (3 vertices per triangle, in triangle order: draw
-  /// `3 * firstTriangle` onwards), made on first use.
+  /// `3 * firstTriangle` onwards), made on first use. Every triangle of a polygon carries the
+  /// polygon's normal (Newell's), its first corner as the point to light (attribute 4) and that
+  /// corner's colour, so that a polygon is lit once (XGL per-facet illumination).
   GLuint facetVao();
   /// \brief The segment stream of the polygon edges (`edges`) or the lines, made on first use.
   /// Bind it, then point it at the part's first segment with bindSegments().
@@ -70,7 +69,6 @@ class GpuMesh {
   std::size_t edgeOffset_ = 0, lineOffset_ = 0, pointOffset_ = 0, markerOffset_ = 0;
   std::vector<GpuPart> parts_;
   bool hasColors_ = false;
-  bool provokingFacetNormals_ = false;
 
   gl::VertexArray facetVao_;
   gl::Buffer facetBuffer_;

@@ -322,6 +322,9 @@ struct Renderer::Impl {
     glUniform1f(u.power, s.specularPower);
     glUniform1i(u.components, s.lightComponents);
     glUniform1f(u.alpha, alpha);
+    glUniform3f(u.emission, s.emission.r, s.emission.g, s.emission.b);
+    glUniform3f(u.ambientColor, s.ambientColor.color.r, s.ambientColor.color.g, s.ambientColor.color.b);
+    glUniform1i(u.ambientOwn, s.ambientColor.own ? 1 : 0);
   }
 
   static void setModel(const ProgramUniforms& u, const Mat4& model, const std::array<float, 9>& normals) {
@@ -427,7 +430,7 @@ struct Renderer::Impl {
       glBindVertexArray(gpu.vltmVao());
       gpu.bindVltm(mp.firstTriangleIndex / 3);
       glDrawArraysInstanced(GL_TRIANGLES, 0, 3 * segments * segments, triangles / 3);
-    } else if (key.shading == Shading::kFacet && !gpu.provokingNormalsAreFacetNormals()) {
+    } else if (key.shading == Shading::kFacet) {
       glUniform1i(u.facetStream, 1);
       glBindVertexArray(gpu.facetVao());
       glDrawArrays(GL_TRIANGLES, static_cast<GLint>(mp.firstTriangleIndex), triangles);
@@ -1045,7 +1048,7 @@ void Renderer::drawShow(const Show& show, const Viewport& viewport,
     return view;
   };
   if (show.global().stereo) {
-    const float half = 0.5f * show.stereo().eyeSpacing;
+    const float half = 0.5f * runtime::eyeSpacingInWindowUnits(show);
     const runtime::ViewTransforms left = adjusted(runtime::computeEyeView(show, aspect, -half));
     const runtime::ViewTransforms right = adjusted(runtime::computeEyeView(show, aspect, half));
     if (show.stereo().mode == runtime::StereoMode::kAnaglyph) {
@@ -1104,7 +1107,7 @@ Result<void> Renderer::drawStochastic(const Show& show, const Viewport& viewport
     pass.viewport = viewport;
     pass.jitter = jitterOffsets()[static_cast<std::size_t>(i)];
     if (show.global().stereo) {
-      const float half = 0.5f * show.stereo().eyeSpacing;
+      const float half = 0.5f * runtime::eyeSpacingInWindowUnits(show);
       ViewPass right = pass;
       pass.colorMask = {true, false, false};
       draw(show, runtime::computeEyeView(show, aspect, -half), pass);

@@ -66,8 +66,9 @@ void locate(GLuint p, ProgramUniforms& u) {
   auto at = [p](const char* name) { return glGetUniformLocation(p, name); };
   auto surface = [&](const char* prefix, ProgramUniforms::SurfaceLocations& s) {
     auto field = [&](const char* f) { return at(fmt::format("{}.{}", prefix, f).c_str()); };
-    s = {field("color"), field("specularColor"), field("ka"),         field("kd"),
-         field("ks"),    field("power"),         field("components"), field("alpha")};
+    s = {field("color"),    field("specularColor"), field("ka"),         field("kd"),
+         field("ks"),       field("power"),         field("components"), field("alpha"),
+         field("emission"), field("ambientColor"),  field("ambientOwn")};
   };
   u.model = at("uModel");
   u.normalMatrix = at("uNormalMatrix");

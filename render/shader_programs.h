@@ -51,6 +51,7 @@ struct VariantKey {
 struct ProgramUniforms {
   struct SurfaceLocations {
     GLint color = -1, specularColor = -1, ka = -1, kd = -1, ks = -1, power = -1, components = -1, alpha = -1;
+    GLint emission = -1, ambientColor = -1, ambientOwn = -1;
   };
   GLint model = -1, normalMatrix = -1, colorSource = -1, backLit = -1, frontLit = -1, texcoordFlip = -1;
   GLint facetStream = -1;

@@ -172,7 +172,7 @@ void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
       case ViewKind::kStereo: {
         // One eye of the show's stereo pair, filling the view: a passive projector per eye.
         const float aspect = static_cast<float>(std::max(vp.width, 1U)) / static_cast<float>(std::max(vp.height, 1U));
-        const float half = 0.5f * show.stereo().eyeSpacing;
+        const float half = 0.5f * runtime::eyeSpacingInWindowUnits(show);
         runtime::ViewTransforms t = runtime::computeEyeView(show, aspect, v.spec.eye == Eye::kLeft ? -half : half);
         if (adjust) adjust(t);
         render::ViewPass pass;

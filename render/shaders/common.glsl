@@ -27,6 +27,8 @@ layout(std140) uniform Frame {
   vec4 uLightPosition[32];   // xyz position, w: attenuation c1
   vec4 uLightDirection[32];  // xyz unit direction the light travels, w: attenuation c2
   vec4 uLightSpot[32];       // x: cos(spot angle), y: spot exponent
+  vec4 uLightAmbient[32];    // rgb: the light's ambient colour (an ambient light's Lc)
+  vec4 uLightSpecular[32];   // rgb: the light's specular colour (Lc unless the light has its own)
   vec4 uClipPlane[16];       // xyz: unit normal towards what is kept, w: -dot(normal, point)
 };
 
@@ -46,19 +48,26 @@ struct Surface {
   float power;         // Se
   int components;      // bit 0 ambient, 1 diffuse, 2 specular
   float alpha;         // 1 - transparency
+  vec3 emission;       // thesis §4.2.4: emitted whatever the lights (XGL: black)
+  vec3 ambientColor;   // the ambient reflectance's colour when ambientOwn is 1
+  int ambientOwn;      // 0: the ambient term reflects Od (XGL); 1: ambientColor (thesis)
 };
 
-// The XGL reflection model summed over every light that is on, clamped to 1 per channel.
-// P: point, N: unit normal, E: unit vector to the eye, all in world coordinates.
-// A light behind the surface (N.L <= 0) reaches it not at all: no diffuse, no highlight.
+// The XGL reflection model summed over every light that is on, clamped to 1 per channel, with
+// the thesis' (OpenGL's) additions: the material's emission first, and each light's own ambient
+// colour, attenuated like its other terms. P: point, N: unit normal, E: unit vector to the eye,
+// all in world coordinates. A light behind the surface (N.L <= 0) gives no diffuse and no
+// highlight.
 vec3 illuminate(vec3 P, vec3 N, vec3 E, Surface s, vec3 Od) {
-  vec3 sum = vec3(0.0);
+  vec3 sum = s.emission;
+  vec3 Oa = s.ambientOwn == 1 ? s.ambientColor : Od;
   for (int i = 0; i < uCounts.x; ++i) {
     vec4 colorType = uLightColor[i];
     vec3 Lc = colorType.rgb;
     int type = int(colorType.w);
+    vec3 ambient = (s.components & 1) != 0 ? s.ka * Oa * uLightAmbient[i].rgb : vec3(0.0);
     if (type == 0) {
-      if ((s.components & 1) != 0) sum += s.ka * Od * Lc;
+      sum += ambient;
       continue;
     }
     vec3 L;
@@ -76,12 +85,13 @@ vec3 illuminate(vec3 P, vec3 N, vec3 E, Surface s, vec3 Od) {
       }
     }
     float NdotL = dot(N, L);
-    if (NdotL <= 0.0) continue;
-    vec3 c = vec3(0.0);
-    if ((s.components & 2) != 0) c += s.kd * Od * Lc * NdotL;
-    if ((s.components & 4) != 0) {
-      vec3 R = 2.0 * NdotL * N - L;
-      c += s.ks * s.specularColor * Lc * pow(max(dot(E, R), 0.0), s.power);
+    vec3 c = ambient;
+    if (NdotL > 0.0) {
+      if ((s.components & 2) != 0) c += s.kd * Od * Lc * NdotL;
+      if ((s.components & 4) != 0) {
+        vec3 R = 2.0 * NdotL * N - L;
+        c += s.ks * s.specularColor * uLightSpecular[i].rgb * pow(max(dot(E, R), 0.0), s.power);
+      }
     }
     sum += attenuation * c;
   }

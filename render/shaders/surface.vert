@@ -3,8 +3,9 @@
 // One shading #define picks where the light is computed (XGL "Illumination and Shading"):
 //   SHADE_UNLIT_FLAT    illumination none: the material colour, one per facet
 //   SHADE_UNLIT_SMOOTH  interpolated colour: vertex colours interpolated, no light
-//   SHADE_FACET         per facet: one lighting calculation per facet, at its last vertex, with
-//                       the facet's normal (drawn from the de-indexed facet stream)
+//   SHADE_FACET         per facet: one lighting calculation per polygon, at its first corner,
+//                       with the polygon's normal (drawn from the de-indexed facet stream, whose
+//                       vertices all carry both)
 //   SHADE_VERTEX        per vertex (Gouraud): light at each vertex, colours interpolated
 //   SHADE_PIXEL         per pixel: normals interpolated, light at each pixel (beyond XGL)
 // TWO_SIDED lights back faces with the back surface and the normal reversed (face
@@ -15,6 +16,7 @@ layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;  // the facet normal in the facet stream
 layout(location = 2) in vec4 aColor;   // vertex colour (facet colour in the facet stream)
 layout(location = 3) in vec2 aTexcoord;
+layout(location = 4) in vec3 aFacetPoint;  // the facet stream: the polygon's lit corner
 
 uniform mat4 uModel;
 uniform mat3 uNormalMatrix;
@@ -66,21 +68,23 @@ void main() {
 #elif defined(SHADE_FACET) || defined(SHADE_VERTEX)
 #ifdef SHADE_FACET
   // GLES takes a flat value from the last vertex of each triangle: in the facet stream (three
-  // vertices per triangle, in order) light only that one; an indexed mesh whose last vertices
-  // carry the facet normals lights each of its vertices once.
+  // vertices per triangle, in order) light only that one, at the polygon's lit corner, so that
+  // every triangle of a polygon gets the same colour.
   bool provoking = uFacetStream == 0 || (gl_VertexID % 3) == 2;
+  vec3 litPoint = uFacetStream == 1 ? (uModel * vec4(aFacetPoint, 1.0)).xyz : world.xyz;
 #else
   bool provoking = true;
+  vec3 litPoint = world.xyz;
 #endif
-  vec3 E = normalize(uEye.xyz - world.xyz);
+  vec3 E = normalize(uEye.xyz - litPoint);
   vFront = vec4(0.0, 0.0, 0.0, uFront.alpha);
 #ifdef TWO_SIDED
   vBack = vec4(0.0, 0.0, 0.0, uBack.alpha);
 #endif
   if (provoking) {
-    vFront.rgb = illuminate(world.xyz, N, E, uFront, frontOd);
+    vFront.rgb = illuminate(litPoint, N, E, uFront, frontOd);
 #ifdef TWO_SIDED
-    vBack.rgb = uBackLit == 1 ? illuminate(world.xyz, -N, E, uBack, backOd) : backOd;
+    vBack.rgb = uBackLit == 1 ? illuminate(litPoint, -N, E, uBack, backOd) : backOd;
 #endif
   }
 #else

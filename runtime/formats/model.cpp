@@ -178,12 +178,28 @@ void applyMaterial(runtime::Show& show, runtime::PartId part, const runtime::Mat
   }
 }
 
+void applySceneMaterial(runtime::Show& show, runtime::PartId part, const runtime::Material& material) {
+  using runtime::AttrId;
+  using runtime::PartStyle;
+  applyMaterial(show, part, material);
+  const runtime::Color3 ambient = clamp01(material.ambient);
+  const runtime::Color3 emission = clamp01(material.emissive);
+  show.editPartStyle(part, AttrId::kFrontAmbient, [&](PartStyle& s) { s.front.ambient = 1.0f; });
+  show.editPartStyle(part, AttrId::kFrontAmbientColor, [&](PartStyle& s) { s.front.ambientColor = {true, ambient}; });
+  show.editPartStyle(part, AttrId::kFrontEmission, [&](PartStyle& s) { s.front.emission = emission; });
+  // OpenGL's shininess runs 0..128; 0 is a highlight everywhere, as (R.E)^0 is.
+  const float shininess = std::isfinite(material.shininess) ? std::clamp(material.shininess, 0.0f, 128.0f) : 0.0f;
+  show.editPartStyle(part, AttrId::kFrontSpecularPower, [&](PartStyle& s) { s.front.specularPower = shininess; });
+}
+
 namespace {
 
 struct Entry {
   const LoadedModel* model = nullptr;
   const ModelObject* object = nullptr;
   const runtime::Material* materialState = nullptr;
+  bool sceneMaterial = false;
+  std::string instanceOf;         // the object whose geometry an instance shares ("" = its own)
   std::int32_t parentEntry = -1;  // among entries
   std::int32_t parentNode = -1;   // a node already in the Show
   std::shared_ptr<const runtime::Mesh> mesh;
@@ -208,6 +224,7 @@ std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<Mo
       e.model = import.model;
       e.object = &o;
       e.materialState = import.materialState;
+      e.sceneMaterial = import.sceneMaterial;
       e.mesh = o.mesh;
       entries.push_back(std::move(e));
     }
@@ -236,11 +253,13 @@ std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<Mo
         const Entry& source = entries[static_cast<std::size_t>(it->second)];
         if (source.object->mesh) {
           e.mesh = source.object->mesh;
+          e.instanceOf = source.object->name;
           break;
         }
         target = &source.object->instanceOf;
       } else if (auto node = show.findNode(*target); node && show.nodes()[*node].mesh) {
         e.mesh = show.nodes()[*node].mesh;
+        e.instanceOf = *target;
         break;
       } else {
         note(e, fmt::format("'{}' is an instance of '{}', which is not loaded; it has no geometry", e.object->name,
@@ -302,6 +321,11 @@ std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<Mo
                         : e.parentNode;
       node.local = e.object->localTransform();
       node.mesh = e.mesh;
+      if (!e.instanceOf.empty() && e.mesh) {
+        for (const runtime::MeshPart& mp : e.mesh->parts) {
+          node.partNames.push_back(mp.name == e.instanceOf ? e.object->name : e.object->name + "/" + mp.name);
+        }
+      }
       node.colorMap = e.object->colorMap;
       node.reflectionMap = e.object->reflectionMap;
       node.bumpMap = e.object->bumpMap;
@@ -332,6 +356,8 @@ std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<Mo
       }
       if (material) {
         applyMaterial(show, id, *material);
+      } else if (e.materialState && e.sceneMaterial) {
+        applySceneMaterial(show, id, *e.materialState);
       } else if (e.materialState) {
         applyMaterial(show, id, *e.materialState);
       }

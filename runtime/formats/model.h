@@ -100,9 +100,16 @@ ModelCounts countModel(const LoadedModel& model);
 /// the Show; parts without a material take `materialState` when it is given (the scene's
 /// material state in force at the import). Problems (an unknown parent, a cycle) are warnings:
 /// the object is placed at the root. Returns the node id of each object, models in order.
+///
+/// An instance (`instanceof`) shares its original's geometry but not its parts: its parts are
+/// parts of its own, named after it (the original's part named after the original becomes the
+/// instance's name, any other part `instance/part`), so that its material and attributes never
+/// repaint the original (thesis §4.2.9: instances share vertex and face data only).
 struct ModelImport {
   const LoadedModel* model = nullptr;
   const runtime::Material* materialState = nullptr;  ///< null: parts keep their own or the default
+  /// The state is a scene's (thesis §4.2.4, OpenGL's material): applied with applySceneMaterial.
+  bool sceneMaterial = false;
 };
 std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<ModelImport>& imports,
                                        std::vector<Diagnostic>& warnings);
@@ -111,6 +118,11 @@ std::vector<runtime::NodeId> addModels(runtime::Show& show, const std::vector<Mo
 /// Kd, ambient and specular as reflectance factors, Ks as the specular colour, Ns as the
 /// power, 1 - d as transparency; also the line and marker colour (as `obj_colors.part_color`).
 void applyMaterial(runtime::Show& show, runtime::PartId part, const runtime::Material& material);
+
+/// \brief A scene's material state exactly (thesis §4.2.4, E.5): applyMaterial's colour,
+/// diffuse and specular, with the ambient colour as the part's own ambient reflectance (ka 1),
+/// the emission, and the shininess as the specular power.
+void applySceneMaterial(runtime::Show& show, runtime::PartId part, const runtime::Material& material);
 
 // ---- Writing ---------------------------------------------------------------------------------
 

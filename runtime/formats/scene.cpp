@@ -497,6 +497,19 @@ Result<LoadedScene> loadScene(const std::filesystem::path& path, const LoadOptio
       return;
     }
     for (Diagnostic& w : model->warnings) scene.warnings.push_back(w);
+    // The thesis applies the scene's material state to every model it imports (§4.3.5); a
+    // part with a material of its own (an MTL file's) keeps that one instead, and says so.
+    bool ownMaterials = false;
+    for (const ModelObject& o : model->objects) {
+      if (!o.mesh) continue;
+      for (const runtime::MeshPart& part : o.mesh->parts) ownMaterials = ownMaterials || part.material >= 0;
+    }
+    if (ownMaterials) {
+      scene.warnings.push_back(
+          {where(s), fmt::format("{} has materials of its own (MTL); its parts that use one keep it instead of the "
+                                 "scene's material state",
+                                 file.filename().string())});
+    }
     scene.models.push_back({std::move(*model), s.material});
   };
   for (const SceneSource& s : scene.description.sources) {
@@ -573,7 +586,7 @@ void applyScene(runtime::Show& show, const LoadedScene& scene, std::vector<Diagn
   std::vector<ModelImport> imports;
   for (const LoadedScene::Import& i : scene.models) {
     materials.push_back(i.material.toMaterial());
-    imports.push_back({&i.model, &materials.back()});
+    imports.push_back({&i.model, &materials.back(), true});
   }
   addModels(show, imports, out);
   for (const LoadedScene::PlacedTerrain& t : scene.terrains) {
@@ -584,25 +597,28 @@ void applyScene(runtime::Show& show, const LoadedScene& scene, std::vector<Diagn
     node.source = scene.path.string();
     const runtime::NodeId id = show.addTerrain(std::move(node), t.terrain.heights);
     materials.push_back(t.material.toMaterial());
-    for (runtime::PartId part : show.nodes()[id].partIds) applyMaterial(show, part, materials.back());
+    for (runtime::PartId part : show.nodes()[id].partIds) applySceneMaterial(show, part, materials.back());
   }
   if (!d.lights.empty()) {
+    // Thesis §4.2.4 (OpenGL): the global ambient colour (OpenGL's default 0.2, which a scene
+    // file cannot change) scaled by the material's ambient colour, then each light with its
+    // own ambient, diffuse and specular colours, in the scene's units.
     auto& lights = show.lights();
     for (runtime::Light& l : lights) l.on = false;
-    runtime::Color3 ambient{0, 0, 0};
-    for (const SceneLight& l : d.lights) {
-      ambient = {ambient.r + l.ambient.r, ambient.g + l.ambient.g, ambient.b + l.ambient.b};
-    }
     lights[0] = runtime::Light{};
+    lights[0].on = true;
     lights[0].type = runtime::LightType::kAmbient;
-    lights[0].color = {std::min(ambient.r, 1.0f), std::min(ambient.g, 1.0f), std::min(ambient.b, 1.0f)};
-    lights[0].on = ambient != runtime::Color3{0, 0, 0};
+    lights[0].color = kSceneGlobalAmbient;
     for (std::size_t i = 0; i < d.lights.size() && i + 1 < lights.size(); ++i) {
       const SceneLight& s = d.lights[i];
       runtime::Light& l = lights[i + 1];
       l = runtime::Light{};
       l.on = true;
+      l.units = runtime::Units::kScene;
       l.color = s.diffuse;
+      l.ambient = s.ambient;
+      l.specular = s.specular;
+      l.ownSpecular = true;
       const Vec3 p = s.position.xyz();
       if (s.position.w == 0) {
         l.type = runtime::LightType::kDirectional;
@@ -631,7 +647,10 @@ void applyScene(runtime::Show& show, const LoadedScene& scene, std::vector<Diagn
     f.start = d.fog->start;
     f.end = d.fog->end;
     f.density = d.fog->density;
+    f.units = runtime::Units::kScene;
   }
+  show.stereo().eyeSpacing = d.eyeSpacing;
+  show.stereo().units = runtime::Units::kScene;
   runtime::Viewer& v = show.viewer();
   v.fromScene = true;
   v.position = d.position;
@@ -690,15 +709,20 @@ SceneDescription describeScene(const runtime::Show& show, const std::filesystem:
     d.fog = fog;
   }
   runtime::Color3 ambient{0, 0, 0};
-  for (const runtime::Light& l : show.lights()) {
+  for (std::size_t i = 0; i < show.lights().size(); ++i) {
+    const runtime::Light& l = show.lights()[i];
     if (!l.on) continue;
     if (l.type == runtime::LightType::kAmbient) {
-      ambient = {ambient.r + l.color.r, ambient.g + l.color.g, ambient.b + l.color.b};
+      // A scene's light 0 is the global ambient every scene has; not a light of the file.
+      if (i == 0 && l.color == kSceneGlobalAmbient && l.ambient == runtime::Color3{0, 0, 0}) continue;
+      ambient = {ambient.r + l.color.r + l.ambient.r, ambient.g + l.color.g + l.ambient.g,
+                 ambient.b + l.color.b + l.ambient.b};
       continue;
     }
     SceneLight s;
-    s.ambient = {0, 0, 0};
-    s.diffuse = s.specular = l.color;
+    s.ambient = l.ambient;
+    s.diffuse = l.color;
+    s.specular = l.ownSpecular ? l.specular : l.color;
     if (l.type == runtime::LightType::kDirectional) {
       const Vec3 towards = -normalize(l.direction);
       s.position = {towards.x, towards.y, towards.z, 0};
@@ -713,7 +737,9 @@ SceneDescription describeScene(const runtime::Show& show, const std::filesystem:
       s.diffuse = s.specular = {0, 0, 0};
       d.lights.push_back(s);
     }
-    d.lights.front().ambient = {std::min(ambient.r, 1.0f), std::min(ambient.g, 1.0f), std::min(ambient.b, 1.0f)};
+    SceneLight& first = d.lights.front();
+    first.ambient = {std::min(first.ambient.r + ambient.r, 1.0f), std::min(first.ambient.g + ambient.g, 1.0f),
+                     std::min(first.ambient.b + ambient.b, 1.0f)};
   }
   std::vector<std::string> seen;
   for (const runtime::SceneNode& n : show.nodes()) {

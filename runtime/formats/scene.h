@@ -42,6 +42,11 @@ struct SceneMaterial {
   [[nodiscard]] runtime::Material toMaterial() const;
 };
 
+/// \brief The global ambient colour a scene's lights come with: OpenGL's default light-model
+/// ambient (thesis §4.2.4 adds it, scaled by the material's ambient colour; a scene file has no
+/// statement for it). applyScene puts it in light 0, an ambient light.
+inline constexpr runtime::Color3 kSceneGlobalAmbient{0.2f, 0.2f, 0.2f};
+
 enum class SceneFogFunction : std::uint8_t { kLinear, kExp, kExp2 };
 
 struct SceneFog {
@@ -143,10 +148,12 @@ struct LoadedScene {
 [[nodiscard]] Result<LoadedScene> loadScene(const std::filesystem::path& path, const LoadOptions& options = {});
 
 /// \brief Puts a scene into the Show: clears it (LAVA resets on a new load), imports the models
-/// with their material states, parents and instances across models resolved by object name,
-/// adds the terrains, sets the lights (the scene's replace LAVA's defaults: its ambient colours
-/// add up into light 0, its lights follow), background colour, image or skybox, fog and the
-/// viewer. Problems are appended to `warnings`.
+/// with their material states (applySceneMaterial), parents and instances across models
+/// resolved by object name, adds the terrains, sets the lights (the scene's replace LAVA's
+/// defaults: light 0 is the global ambient kSceneGlobalAmbient, the scene's lights follow with
+/// their own ambient, diffuse and specular colours), background colour, image or skybox, fog,
+/// the stereo eye spacing and the viewer. Lights, fog and eye spacing are in the scene's units
+/// (`runtime::Units::kScene`). Problems are appended to `warnings`.
 void applyScene(runtime::Show& show, const LoadedScene& scene, std::vector<Diagnostic>* warnings = nullptr);
 
 /// \brief What a Show holds, as a scene description: background, fog, lights and viewer from the

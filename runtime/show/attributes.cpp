@@ -85,6 +85,10 @@ constexpr AttrField kFields[] = {
     BASALT_NESTED(kNurbsIsoCurvesU, "nurbs.iso_curves_u", nurbs, isoCurvesU),
     BASALT_NESTED(kNurbsIsoCurvesV, "nurbs.iso_curves_v", nurbs, isoCurvesV),
     BASALT_NESTED(kNurbsTessellation, "nurbs.tessellation", nurbs, tessellation),
+    BASALT_NESTED(kFrontEmission, "front_surf.emission", front, emission),
+    BASALT_NESTED(kFrontAmbientColor, "front_surf.ambient_color", front, ambientColor),
+    BASALT_NESTED(kBackEmission, "back_surf.emission", back, emission),
+    BASALT_NESTED(kBackAmbientColor, "back_surf.ambient_color", back, ambientColor),
 };
 #undef BASALT_NESTED
 

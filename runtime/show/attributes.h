@@ -135,6 +135,17 @@ struct SurfaceAttributes {
   TransparencyMethod transparencyMethod = TransparencyMethod::kNone;  // "None ... default"
   TransparencyBlend transparencyBlend = TransparencyBlend::kNone;     // "None ... (default)"
   float transparency = 0.0f;                                          // 0 opaque .. 1 fully transparent
+  /// Thesis §4.2.4 (OpenGL materials), beyond XGL: the colour the surface emits whatever the
+  /// lights, added before them. XGL surfaces emit nothing, so black unless a scene sets it.
+  Color3 emission{0, 0, 0};
+  /// Thesis §4.2.4: the material's own ambient colour. When `own` is false (XGL, LAVA) the
+  /// ambient term reflects the surface colour Od; when true it reflects `color` instead, so a
+  /// scene's ambient and diffuse colours stay independent.
+  struct AmbientColor {
+    bool own = false;
+    Color3 color{0, 0, 0};
+    friend bool operator==(const AmbientColor&, const AmbientColor&) = default;
+  } ambientColor;
   friend bool operator==(const SurfaceAttributes&, const SurfaceAttributes&) = default;
 };
 
@@ -263,6 +274,11 @@ enum class AttrId : std::uint16_t {
   kNurbsIsoCurvesU,
   kNurbsIsoCurvesV,
   kNurbsTessellation,
+  // Thesis materials a scene (or Basalt) sets; LAVA's script has no command for them.
+  kFrontEmission,
+  kFrontAmbientColor,
+  kBackEmission,
+  kBackAmbientColor,
   kCount
 };
 inline constexpr std::size_t kAttrCount = static_cast<std::size_t>(AttrId::kCount);
@@ -288,12 +304,28 @@ PartStyle resolveStyle(const PartStyle& global, const PartStyle& own, const Attr
 
 enum class LightType : std::uint8_t { kAmbient, kDirectional, kPositional, kSpot };
 
+/// \brief The units a light's position and attenuation, fog's distances or the stereo eye
+/// spacing are given in: LAVA's window units (the object normalised into -1..1, the eye
+/// `view.perspective` away), or the scene's own units (a `.sce` file's coordinates, before
+/// Basalt fits the scene to the window): the renderer carries the second through the model
+/// matrix so that they keep their meaning at any fit.
+enum class Units : std::uint8_t { kWindow, kScene };
+
 /// \brief One of the 32 lights (LAVA "Lighting", XGL chapter 16). Directions point the way the
 /// light travels; angles are in radians, as LAVA's menu takes them.
+///
+/// `color` is XGL's light colour Lc: the ambient colour of an ambient light, the diffuse and
+/// specular colour of the others. A scene's light (thesis §4.2.4, E.3) has three colours of its
+/// own: `ambient` (added, attenuated, whatever the light's type) and, with `ownSpecular`,
+/// `specular` instead of Lc in the highlight. LAVA's lights have neither.
 struct Light {
   bool on = false;  // "Default is OFF" (lights 0-2 are on)
   LightType type = LightType::kDirectional;
   Color3 color{1, 1, 1};
+  Color3 ambient{0, 0, 0};   // thesis: the light's ambient colour (LAVA: none)
+  Color3 specular{1, 1, 1};  // thesis: the light's specular colour, used when ownSpecular
+  bool ownSpecular = false;
+  Units units = Units::kWindow;  // of position and attenuation2
   Vec3 direction{0, 0, -1};
   Vec3 position{0, 0, 1};
   float attenuation1 = 1.0f;  // c1 in A = 1/(c1 + c2 d)
@@ -324,13 +356,15 @@ struct DepthCue {
 enum class FogMode : std::uint8_t { kNone, kLinear, kExp, kExp2 };
 
 /// \brief Thesis §4.3.3 fog, OpenGL's fog functions on the eye-space depth z of each pixel (in
-/// window units, the eye sits `view.perspective` units from the object's centre):
+/// `units`: window units, where the eye sits `view.perspective` from the object's centre, or,
+/// for a scene's fog, the scene's own units):
 /// linear f = (end - z) / (end - start), exp f = e^(-density z), exp2 f = e^(-(density z)^2),
 /// f clamped to 0..1, and the colour f C + (1 - f) fog colour. Fog is off unless `mode` says so;
 /// the thesis gives no defaults for the rest (Basalt defaults, chosen to fog the far half of
 /// the default view).
 struct Fog {
   FogMode mode = FogMode::kNone;
+  Units units = Units::kWindow;  // of start, end and density (a scene's fog: kScene)
   Color3 color{0.5f, 0.5f, 0.5f};
   float start = 1.0f;
   float end = 10.0f;
@@ -411,7 +445,8 @@ enum class StereoMode : std::uint8_t { kAnaglyph, kSideBySide, kTopBottom };
 /// 0.04), left eye red, right eye cyan, converging on the object's centre plane.
 struct StereoSettings {
   StereoMode mode = StereoMode::kAnaglyph;
-  float eyeSpacing = 0.04f;  // thesis C.3 default, in window units
+  float eyeSpacing = 0.04f;  // thesis C.3 default, in `units`
+  Units units = Units::kWindow;
   friend bool operator==(const StereoSettings&, const StereoSettings&) = default;
 };
 

@@ -12,7 +12,10 @@ NodeId Show::addNode(SceneNode node) {
   node.partIds.clear();
   if (node.mesh) {
     node.partIds.reserve(node.mesh->parts.size());
-    for (const MeshPart& mp : node.mesh->parts) node.partIds.push_back(internPart(mp.name));
+    const bool own = node.partNames.size() == node.mesh->parts.size();
+    for (std::size_t k = 0; k < node.mesh->parts.size(); ++k) {
+      node.partIds.push_back(internPart(own ? node.partNames[k] : node.mesh->parts[k].name));
+    }
   }
   if (node.parent >= static_cast<std::int32_t>(nodes_.size())) node.parent = -1;
   nodes_.push_back(std::move(node));
@@ -245,6 +248,24 @@ Mat4 viewNormalisation(const Show& show) {
     case ObjectScale::kOriginal: scale = 1.0f; break;
   }
   return Mat4::scaling({scale, scale, scale}) * Mat4::translation(-center);
+}
+
+float uniformScale(const Mat4& m) {
+  const float det = m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) -
+                    m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0)) +
+                    m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0));
+  return std::cbrt(std::fabs(det));
+}
+
+float sceneScale(const Show& show) {
+  return uniformScale(show.position().global * show.position().local * viewNormalisation(show));
+}
+
+float eyeSpacingInWindowUnits(const Show& show) {
+  const StereoSettings& s = show.stereo();
+  if (s.units == Units::kWindow) return s.eyeSpacing;
+  const float scale = sceneScale(show);
+  return scale > 0 && std::isfinite(scale) ? s.eyeSpacing * scale : s.eyeSpacing;
 }
 
 ViewTransforms computeView(const Show& show, float aspect) { return computeEyeView(show, aspect, 0.0f); }

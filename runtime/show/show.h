@@ -34,6 +34,9 @@ struct SceneNode {
   Mat4 local;                        ///< relative to the parent
   std::shared_ptr<const Mesh> mesh;  ///< null for grouping nodes; shared by instances
   std::vector<PartId> partIds;       ///< the Show part of each mesh part, same order
+  /// The Show part names of the mesh's parts, same order, when this node's parts are its own (an
+  /// instance's); empty: the mesh's part names, shared with every node that has the same name.
+  std::vector<std::string> partNames;
   bool visible = true;
   /// Extended OBJ `usemap` maps (thesis C.2), resolved against the model's folder: the colour
   /// map textures the node's parts that have no material map of their own; the spherical
@@ -105,8 +108,9 @@ class Show {
 
   // ---- Scene graph ----
   [[nodiscard]] const std::vector<SceneNode>& nodes() const { return nodes_; }
-  /// \brief Adds a node; its mesh parts become Show parts (parts with the same name are shared,
-  /// so instances and repeated names are addressed together). Parents must be added first.
+  /// \brief Adds a node; its mesh parts become Show parts, named by `node.partNames` or the mesh
+  /// (parts with the same name are shared, so repeated names are addressed together). Parents
+  /// must be added first.
   NodeId addNode(SceneNode node);
   void setNodeTransform(NodeId id, const Mat4& local);
   /// \brief The first node with this name.
@@ -277,6 +281,17 @@ ViewTransforms computeEyeView(const Show& show, float aspect, float eyeOffset);
 /// \brief The scene's normalisation (centre and scale into window units, LAVA "View"): what
 /// computeView() puts between the scene and the local matrix.
 Mat4 viewNormalisation(const Show& show);
+
+/// \brief The uniform scale of a transform: the cube root of its 3 x 3 determinant's magnitude
+/// (how many units of the target one unit of the source is, for similarity transforms).
+float uniformScale(const Mat4& m);
+
+/// \brief How many window units one scene unit is in the plain view: the scale of the global
+/// and local matrices and the normalisation (what `Units::kScene` lengths are multiplied by).
+float sceneScale(const Show& show);
+
+/// \brief The stereo eye spacing in window units (a scene's `eyespacing` is in scene units).
+float eyeSpacingInWindowUnits(const Show& show);
 
 /// \brief Where the floor and the fake shadow go (LAVA "Environment").
 struct FloorGeometry {

@@ -198,21 +198,81 @@ TEST_F(Lighting, SpherePerPixelFollowsTheEquations) {
 
 class Illuminations : public RenderTest {};
 
-TEST_F(Illuminations, PerFacetLightsEachTriangleOnceAtItsLastVertex) {
-  Show show = showOf(makeQuad(1.0f, 0.0f, 1));
-  lightsOff(show);
-  show.lights()[0] = makeLight(LightType::kPositional);
-  setMaterial(show, Illumination::kPerFacet);
-  const runtime::ViewTransforms view = testCamera();
-  const Image image = render(show, view);
-  // Triangles (a, b, c) and (a, c, d) of the quad: a lower left, b lower right, c upper right,
-  // d upper left. GLES takes flat values from the last vertex: c and d.
-  const D3 atC = reference(show, show.globalStyle().front, {1, 1, 0}, {0, 0, 1}, d3(view.eye));
-  const D3 atD = reference(show, show.globalStyle().front, {-1, 1, 0}, {0, 0, 1}, d3(view.eye));
-  expectPixel(image, 200, 230, atC, 2.0 / 255, "lower-right triangle");
-  expectPixel(image, 240, 100, atC, 2.0 / 255, "lower-right triangle");
-  expectPixel(image, 30, 60, atD, 2.0 / 255, "upper-left triangle");
-  expectPixel(image, 100, 10, atD, 2.0 / 255, "upper-left triangle");
+// XGL Programmer's Guide ch. 16, "Illumination and Shading": "Facet: Illumination per facet
+// results in one lighting calculation for each polygon. XGL draws the entire polygon in this
+// reflected color. [...] The vertex chosen for the lighting calculation is device-dependent."
+// Basalt's choice is the polygon's first corner (OpenGL's provoking vertex of a GL_POLYGON, the
+// thesis' primitive), with the polygon's normal. So a quad (two triangles) and a pentagon (three)
+// must each show one colour: the reflection model evaluated at the first corner. Each light is
+// aimed so that the corners see it differently (a lit colour per triangle would show).
+// Example failure: each triangle lit at its own last vertex, a quad in two colours.
+
+/// A convex polygon's mesh: the corners in order, fanned from the first, one facet.
+std::shared_ptr<runtime::Mesh> makePolygon(const std::vector<Vec3>& corners) {
+  auto mesh = std::make_shared<runtime::Mesh>();
+  const auto n = static_cast<std::uint32_t>(corners.size());
+  for (const Vec3& c : corners) {
+    mesh->positions.push_back(c);
+    mesh->normals.push_back({0, 0, 1});
+  }
+  for (std::uint32_t i = 1; i + 1 < n; ++i) {
+    for (std::uint32_t v : {0U, i, i + 1}) mesh->triangles.push_back(v);
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    mesh->edges.push_back(i);
+    mesh->edges.push_back((i + 1) % n);
+  }
+  mesh->facetSizes.push_back(n);
+  runtime::MeshPart part;
+  part.name = "polygon";
+  part.triangleIndexCount = static_cast<std::uint32_t>(mesh->triangles.size());
+  part.edgeIndexCount = static_cast<std::uint32_t>(mesh->edges.size());
+  part.facetCount = 1;
+  mesh->parts.push_back(part);
+  return mesh;
+}
+
+/// A spot light above `target`, pointed at it, narrow enough to miss the far corners.
+Light spotAt(const Vec3& target) {
+  Light l = makeLight(LightType::kSpot);
+  l.position = target + Vec3{0.3f, 0.2f, 1.2f};
+  l.direction = normalize(target - l.position);
+  l.angle = 0.3f;
+  l.attenuation2 = 0.0f;
+  return l;
+}
+
+TEST_F(Illuminations, PerFacetLightsEachPolygonOnceAtItsFirstCorner) {
+  const std::vector<Vec3> quad = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  std::vector<Vec3> pentagon;
+  for (int k = 0; k < 5; ++k) {
+    const double a = 3.14159265358979 * (1.25 + 0.4 * k);  // the first corner lower left
+    pentagon.push_back({static_cast<float>(0.95 * std::cos(a)), static_cast<float>(0.95 * std::sin(a)), 0});
+  }
+  for (const auto& [corners, name] : {std::pair{quad, "quad"}, std::pair{pentagon, "pentagon"}}) {
+    const Light lights[] = {makeLight(LightType::kPositional), spotAt(corners[0])};
+    for (const Light& light : lights) {
+      SCOPED_TRACE(std::string(name) + (light.type == LightType::kSpot ? ", spot light" : ", positional light"));
+      Show show = showOf(makePolygon(corners));
+      lightsOff(show);
+      show.lights()[0] = light;
+      setMaterial(show, Illumination::kPerFacet);
+      const runtime::ViewTransforms view = testCamera();
+      const Image image = render(show, view);
+      const D3 expected = reference(show, show.globalStyle().front, d3(corners[0]), {0, 0, 1}, d3(view.eye));
+      EXPECT_GT(expected.x + expected.y + expected.z, 0.1) << "the first corner is lit";
+      // Each triangle of the fan, at its centroid and halfway from there to each of its corners.
+      for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
+        const Vec3 tri[3] = {corners[0], corners[i], corners[i + 1]};
+        const Vec3 centroid = (tri[0] + tri[1] + tri[2]) / 3.0f;
+        for (const Vec3& towards : {centroid, tri[0], tri[1], tri[2]}) {
+          const Vec2 px = worldToPixel(view, (centroid + towards) * 0.5f);
+          expectPixel(image, static_cast<std::uint32_t>(px.x), static_cast<std::uint32_t>(px.y), expected, 2.0 / 255,
+                      fmt::format("triangle {}", i));
+        }
+      }
+    }
+  }
 }
 
 TEST_F(Illuminations, PerVertexInterpolatesTheVertexColours) {

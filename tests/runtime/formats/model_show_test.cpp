@@ -62,7 +62,16 @@ TEST(ModelShow, InstancesShareOneMeshAndParentsComposeAtAnyDepth) {
   EXPECT_NEAR(origin.x, 10.0f, 1e-5f);
   EXPECT_NEAR(origin.y, 2.0f, 1e-5f);
   EXPECT_NEAR(origin.z, 1.0f, 1e-5f);
-  EXPECT_EQ(show.partCount(), 1u) << "instances address the same parts";
+  // Thesis §4.2.9: "instances share all vertex and face data" and each egg "has an independent
+  // location, orientation, and scale"; the material is the model's own (§4.2.4, §4.3.5), so an
+  // instance's parts are its own, named after it, and setting them leaves the original alone.
+  EXPECT_EQ(show.partCount(), 4u) << "each instance has parts of its own";
+  for (const char* name : {"root", "a", "b", "c"}) {
+    const auto node = show.findNode(name);
+    const auto part = show.findPart(name);
+    ASSERT_TRUE(node && part) << name;
+    EXPECT_EQ(show.nodes()[*node].partIds, std::vector<runtime::PartId>{*part}) << name;
+  }
 }
 
 TEST(ModelShow, UnknownParentsAndCyclesArePlacedAtTheRootWithAWarning) {

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "formats_test_util.h"
@@ -182,11 +183,17 @@ TEST(SceneFiles, LoadImportsEverythingAndTheShowGetsIt) {
   EXPECT_EQ(show.resolvedStyle(*table).front.color, (runtime::Color3{1, 0, 0}));
   EXPECT_EQ(show.resolvedStyle(*table).front.specularPower, 20.0f);
   EXPECT_EQ(show.resolvedStyle(*lampPart).front.specular, 1.0f);
-  // Lights: the ambient sum in light 0, then the scene's lights; LAVA's defaults are off.
+  // Lights: OpenGL's global ambient (0.2) in light 0, then the scene's lights, each with its own
+  // ambient, diffuse and specular colours (thesis §4.2.4) in scene units; LAVA's defaults are off.
   const auto& lights = show.lights();
   EXPECT_EQ(lights[0].type, runtime::LightType::kAmbient);
   EXPECT_TRUE(lights[0].on);
   EXPECT_EQ(lights[0].color, (runtime::Color3{0.2f, 0.2f, 0.2f}));
+  EXPECT_EQ(lights[1].ambient, (runtime::Color3{0.2f, 0.2f, 0.2f})) << "light 1's own ambient[51,51,51]";
+  EXPECT_EQ(lights[1].units, runtime::Units::kScene);
+  EXPECT_TRUE(lights[2].ownSpecular);
+  EXPECT_EQ(lights[2].specular, (runtime::Color3{0, 0, 0})) << "light 2's specular[0,0,0], not its diffuse";
+  EXPECT_EQ(lights[2].ambient, (runtime::Color3{0, 0, 0}));
   EXPECT_EQ(lights[1].type, runtime::LightType::kDirectional);
   EXPECT_EQ(lights[1].direction, (Vec3{0, -1, 0})) << "w = 0: shining from +Y down";
   EXPECT_EQ(lights[2].type, runtime::LightType::kPositional);
@@ -197,6 +204,16 @@ TEST(SceneFiles, LoadImportsEverythingAndTheShowGetsIt) {
   EXPECT_EQ(show.backgroundKind(), runtime::BackgroundKind::kSkybox);
   EXPECT_EQ(show.backgroundImage(), (dir / "box.png").string());
   EXPECT_EQ(show.fog().mode, runtime::FogMode::kExp2);
+  EXPECT_EQ(show.fog().units, runtime::Units::kScene);
+  EXPECT_FLOAT_EQ(show.stereo().eyeSpacing, 0.065f) << "eyespacing[0.065] drives the stereo eyes";
+  EXPECT_EQ(show.stereo().units, runtime::Units::kScene);
+  // The second import's state: emission[0,0,255], ambient[0,0,0] as the part's own colours.
+  const runtime::SurfaceAttributes& lampFront = show.resolvedStyle(*lampPart).front;
+  EXPECT_EQ(lampFront.emission, (runtime::Color3{0, 0, 1}));
+  EXPECT_TRUE(lampFront.ambientColor.own);
+  EXPECT_EQ(lampFront.ambientColor.color, (runtime::Color3{0, 0, 0}));
+  EXPECT_EQ(show.resolvedStyle(*table).front.ambientColor.color, (runtime::Color3{0.2f, 0.2f, 0.2f}))
+      << "the thesis' default ambient material";
   EXPECT_EQ(show.viewer().fieldOfView, 45.0f);
   EXPECT_EQ(show.viewer().viewportWidth, 640);
   EXPECT_TRUE(show.viewer().fromScene);
@@ -255,6 +272,58 @@ TEST(SceneFiles, AShowDescribedAndWrittenLoadsBackToTheSameLightsAndViewer) {
   EXPECT_EQ(reloaded.fog(), show.fog());
   EXPECT_EQ(reloaded.backgroundImage(), show.backgroundImage());
   EXPECT_EQ(again->models.size(), 4u) << "one import per model file the Show came from";
+}
+
+TEST(SceneFiles, AnInstanceKeepsItsOwnMaterialAndTheOriginalItsOwn) {
+  // Thesis §4.2.9: instances share "vertex and face data", each has "an independent location,
+  // orientation, and scale"; §4.3.5: "Current (last read) material properties are applied to
+  // objects when they are loaded". The egg is imported yellow, its instance magenta.
+  const auto dir = basalt::test::scratchDir("scene-instance-material");
+  std::ofstream(dir / "egg.obj") << "o egg\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(dir / "egg2.obj") << "o egg2\ninstanceof egg\nposition 3 0 0\nscale 2\n";
+  std::ofstream(dir / "s.sce") << "diffuse[255,255,0]\nimport egg.obj\ndiffuse[255,0,255]\nimport egg2.obj\n";
+  auto scene = loadScene(dir / "s.sce", test::quiet());
+  ASSERT_TRUE(scene) << scene.error().describe();
+  runtime::Show show;
+  applyScene(show, *scene);
+  const auto egg = show.findNode("egg");
+  const auto egg2 = show.findNode("egg2");
+  ASSERT_TRUE(egg && egg2);
+  EXPECT_EQ(show.nodes()[*egg].mesh, show.nodes()[*egg2].mesh) << "one mesh";
+  ASSERT_EQ(show.nodes()[*egg2].partIds.size(), 1u);
+  const runtime::PartId original = show.nodes()[*egg].partIds[0];
+  const runtime::PartId instance = show.nodes()[*egg2].partIds[0];
+  EXPECT_NE(original, instance);
+  EXPECT_EQ(show.part(instance).name, "egg2");
+  EXPECT_EQ(show.resolvedStyle(original).front.color, (runtime::Color3{1, 1, 0})) << "the original stays yellow";
+  EXPECT_EQ(show.resolvedStyle(instance).front.color, (runtime::Color3{1, 0, 1})) << "the instance is magenta";
+  EXPECT_EQ(show.worldTransform(*egg2).transformPoint({1, 0, 0}), (Vec3{5, 0, 0})) << "its own placement";
+}
+
+TEST(SceneFiles, ScaledScenesKeepTheirEyeSpacingInSceneUnits) {
+  // A 0..10 square: its bounds' radius is 5 sqrt 2, so one scene unit is 1 / (5 sqrt 2) window
+  // units, and eyespacing[2] puts the eyes 2 / (5 sqrt 2) = 0.282843 window units apart.
+  const auto dir = basalt::test::scratchDir("scene-eyespacing");
+  std::ofstream(dir / "sq.obj") << "v 0 0 0\nv 10 0 0\nv 10 10 0\nv 0 10 0\nf 1 2 3 4\n";
+  std::ofstream(dir / "s.sce") << "eyespacing[2]\nimport sq.obj\n";
+  auto scene = loadScene(dir / "s.sce", test::quiet());
+  ASSERT_TRUE(scene);
+  runtime::Show show;
+  applyScene(show, *scene);
+  EXPECT_NEAR(runtime::eyeSpacingInWindowUnits(show), 2.0 / (5.0 * std::sqrt(2.0)), 1e-5);
+  show.stereo().units = runtime::Units::kWindow;
+  EXPECT_FLOAT_EQ(runtime::eyeSpacingInWindowUnits(show), 2.0f) << "LAVA's spacing is in window units";
+}
+
+TEST(SceneFiles, AModelWithItsOwnMaterialsSaysTheSceneStateDoesNotApply) {
+  const auto dir = basalt::test::scratchDir("scene-mtl");
+  std::ofstream(dir / "m.mtl") << "newmtl red\nKd 1 0 0\n";
+  std::ofstream(dir / "m.obj") << "mtllib m.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(dir / "s.sce") << "diffuse[0,255,0]\nimport m.obj\n";
+  auto scene = loadScene(dir / "s.sce", test::quiet());
+  ASSERT_TRUE(scene);
+  EXPECT_TRUE(hasWarning(scene->warnings, "s.sce:2: m.obj has materials of its own (MTL)"))
+      << listWarnings(scene->warnings);
 }
 
 TEST(Terrain, GridNormalsAndLimits) {
