@@ -283,6 +283,94 @@ TEST_F(StatusServer, EachControlAnswersWhatItDid) {
   EXPECT_EQ(health["reloads"]["failed"], 0) << h.body;
 }
 
+/// Makes sure the status page's Restart button works for a camera as for a dial box, over real
+/// HTTP: the camera a texture shows is closed and opened again, answers 200, and its texture
+/// shows new frames afterwards (the synthetic camera's box moves, so two snapshots apart differ).
+/// Example failures: a camera refused (409) because its texture stream opens it; a camera
+/// reopened under a texture stream that keeps the closed source, its picture frozen for good.
+TEST(StatusServerRestart, TheRestartButtonRestartsACameraAndADialBox) {
+  std::string why;
+  if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  // The camera sculpture's scene (its sculpture wears the camera), still: nothing turns it.
+  const auto dir = test::writeShow("status-restart-camera", R"(
+[show]
+name = "Restart test"
+entry = "sculpture.sce"
+fps = 30
+
+[output]
+kind = "headless"
+size = "160x120"
+
+[devices.dials]
+kind = "dial_box"
+backend = "synthetic"
+
+[devices.cam]
+kind = "camera"
+backend = "synthetic"
+size = "64x48"
+
+[media.live]
+kind = "camera"
+device = "cam"
+
+[textures."camera.png"]
+source = "live"
+fallback = "camera.png"
+
+[status]
+listen = "127.0.0.1:0"
+token_file = "token"
+)");
+  const auto example = test::sourceDir() / "configs/shows/camera-sculpture";
+  for (const char* file : {"sculpture.sce", "sculpture.obj", "camera.png"}) {
+    std::filesystem::copy_file(example / file, dir / file, std::filesystem::copy_options::overwrite_existing);
+  }
+  std::ofstream(dir / "token") << kToken << "\n";
+  const auto show = test::RunningShow::start({(dir / "show.toml").string(), "--realtime", "--no-resume"}, {}, why);
+  ASSERT_TRUE(show) << why;
+  const std::string bearer = std::string("Bearer ") + kToken;
+  // The camera is live and its texture plays; `newFrames` sees its picture move.
+  const auto cameraPlays = [&] {
+    for (int i = 0; i < 50; ++i) {
+      const auto h = nlohmann::json::parse(show->get("/health").body);
+      const auto cam = named(h["devices"], "cam");
+      if (cam.is_object() && cam["state"] == "live" && h["streams"].size() == 1 &&
+          h["streams"][0]["state"] == "playing")
+        return true;
+      ::usleep(100000);
+    }
+    return false;
+  };
+  const auto newFrames = [&] {
+    const auto before = show->get("/snapshot.png");
+    ::usleep(400000);
+    const auto after = show->get("/snapshot.png");
+    return before.status == 200 && after.status == 200 && before.body != after.body;
+  };
+  ASSERT_TRUE(cameraPlays()) << show->get("/health").body;
+  ASSERT_TRUE(newFrames()) << "the camera's moving box shows before the restart";
+
+  const auto cam = show->post("/control/restart-device?device=cam", "", bearer);
+  EXPECT_EQ(cam.status, 200) << cam.body;
+  EXPECT_NE(cam.body.find("'cam' restarted"), std::string::npos) << cam.body;
+  ::usleep(300000);
+  EXPECT_TRUE(cameraPlays()) << show->get("/health").body;
+  EXPECT_TRUE(newFrames()) << "the texture shows the reopened camera's frames";
+  const auto dials = show->post("/control/restart-device?device=dials", "", bearer);
+  EXPECT_EQ(dials.status, 200) << dials.body;
+  EXPECT_NE(dials.body.find("'dials' restarted"), std::string::npos) << dials.body;
+  // Each restart is in the log, once.
+  show->process().signal(SIGTERM);
+  const std::string out = show->process().wait(std::chrono::seconds(20)).output;
+  EXPECT_NE(out.find("device 'cam' restarted by the control server: live"), std::string::npos) << out;
+  EXPECT_NE(out.find("video source 'cam': Synthetic camera (synthetic at synthetic:camera) is live again"),
+            std::string::npos)
+      << "the camera was really closed and opened: " << out;
+  EXPECT_NE(out.find("device 'dials' restarted by the control server: live"), std::string::npos) << out;
+}
+
 TEST_F(StatusServer, MalformedAndOversizedRequestsAreRefused) {
   // A request line that is not HTTP gets a 400 or the connection closed, never an answer.
   for (const std::string& request : std::vector<std::string>{"HELLO THERE\r\n\r\n", "GET /health HTTP/9.9\r\n\r\n",
