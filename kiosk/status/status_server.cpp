@@ -35,6 +35,8 @@ BASALT_LOG_CATEGORY(Status, "kiosk");
 namespace {
 
 constexpr auto kAnswerWait = std::chrono::seconds(3);
+/// The frame loop reads a snapshot back at most once per period, however many clients ask.
+constexpr auto kSnapshotPeriod = std::chrono::seconds(1);
 
 /// The limits of kiosk/status/README.md, with the show's body size.
 HttpLimits limitsFor(const StatusSpec& spec) {
@@ -168,6 +170,56 @@ void yieldToTheShow() {
 
 }  // namespace
 
+/// The frame on screen, read back by the frame loop at most once per kSnapshotPeriod: requests
+/// within a period share the last picture, and while one request waits for the loop the others
+/// wait for its answer rather than asking again. A failure is kept for the period too, so a hung
+/// loop is not asked again by every client.
+class StatusServer::SnapshotCache {
+ public:
+  struct Taken {
+    int status = 200;  // 200, or 500/503 with `error`
+    std::shared_ptr<const Image> image;
+    std::string error;
+  };
+
+  Taken get(StatusBoard& board) {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      if (last_ && std::chrono::steady_clock::now() - takenAt_ < kSnapshotPeriod) return *last_;
+      if (!asking_) break;
+      answered_.wait(lock);  // the asker waits kAnswerWait at most
+    }
+    asking_ = true;
+    lock.unlock();
+    Taken taken = ask(board);
+    lock.lock();
+    asking_ = false;
+    last_ = taken;
+    takenAt_ = std::chrono::steady_clock::now();
+    answered_.notify_all();
+    return taken;
+  }
+
+ private:
+  static Taken ask(StatusBoard& board) {
+    auto request = std::make_shared<SnapshotRequest>();
+    if (!board.snapshotRequests().push(request)) return {503, nullptr, "too many snapshots asked at once; try again"};
+    board.wake();
+    if (!request->wait(kAnswerWait)) {
+      return {503, nullptr, "the frame loop did not draw a frame within 3 s; it may be hung"};
+    }
+    std::lock_guard lock(request->mutex);
+    if (!request->ok) return {500, nullptr, request->error};
+    return {200, std::make_shared<const Image>(std::move(request->image)), {}};
+  }
+
+  std::mutex mutex_;  // guards everything below
+  std::condition_variable answered_;
+  bool asking_ = false;
+  std::optional<Taken> last_;
+  std::chrono::steady_clock::time_point takenAt_;
+};
+
 /// Token buckets per client address: `rate` requests a second, bursts of twice that.
 class StatusServer::Limiter {
  public:
@@ -205,7 +257,8 @@ StatusServer::StatusServer(const StatusSpec& spec, StatusBoard& board, std::stri
       board_(board),
       token_(std::move(token)),
       server_(std::make_unique<GuardedHttpServer>(limitsFor(spec))),
-      limiter_(std::make_unique<Limiter>(spec.requestsPerSecond)) {}
+      limiter_(std::make_unique<Limiter>(spec.requestsPerSecond)),
+      snapshots_(std::make_unique<SnapshotCache>()) {}
 
 StatusServer::~StatusServer() {
   {
@@ -465,22 +518,12 @@ void StatusServer::routes() {
       }
       width = value;
     }
-    auto request = std::make_shared<SnapshotRequest>();
-    if (!board_.snapshotRequests().push(request)) {
-      replyJson(res, 503, false, "too many snapshots asked at once; try again");
+    const SnapshotCache::Taken taken = snapshots_->get(board_);
+    if (taken.status != 200) {
+      replyJson(res, taken.status, false, taken.error);
       return;
     }
-    board_.wake();
-    if (!request->wait(kAnswerWait)) {
-      replyJson(res, 503, false, "the frame loop did not draw a frame within 3 s; it may be hung");
-      return;
-    }
-    std::lock_guard lock(request->mutex);
-    if (!request->ok) {
-      replyJson(res, 500, false, request->error);
-      return;
-    }
-    auto png = media::encodePng(width ? scaleDown(request->image, width) : request->image);
+    auto png = media::encodePng(width ? scaleDown(*taken.image, width) : *taken.image);
     if (!png) {
       replyJson(res, 500, false, png.error().describe());
       return;

@@ -60,6 +60,7 @@ class StatusServer {
   [[nodiscard]] ServerFacts facts() const { return {controlsEnabled(), spec_.snapshot, readGuarded_}; }
 
   class Limiter;
+  class SnapshotCache;
 
  private:
   StatusServer(const StatusSpec& spec, StatusBoard& board, std::string token);
@@ -83,6 +84,7 @@ class StatusServer {
   std::string readTokenProblem_;
   std::unique_ptr<GuardedHttpServer> server_;
   std::unique_ptr<Limiter> limiter_;
+  std::unique_ptr<SnapshotCache> snapshots_;
   std::thread thread_;
   std::atomic<std::uint16_t> port_{0};
   std::atomic<bool> bound_{false};
