@@ -37,6 +37,8 @@ namespace {
 constexpr auto kAnswerWait = std::chrono::seconds(3);
 /// The frame loop reads a snapshot back at most once per period, however many clients ask.
 constexpr auto kSnapshotPeriod = std::chrono::seconds(1);
+/// A script command from the network is refused past this length before anything parses it.
+constexpr std::size_t kMaxCommandBytes = 1024;
 
 /// The limits of kiosk/status/README.md, with the show's body size.
 HttpLimits limitsFor(const StatusSpec& spec) {
@@ -552,6 +554,12 @@ void StatusServer::routes() {
       if (!auth.starts_with("Bearer ") || !sameSecret(token_, std::string_view(auth).substr(7))) {
         rejectedAuth_.fetch_add(1, std::memory_order_relaxed);
         replyJson(res, 403, false, "wrong token");
+        return;
+      }
+      if (kind == ControlKind::kRunCommand && body->size() > kMaxCommandBytes) {
+        // Refused before anything parses it: a command is one line of a script.
+        rejectedSize_.fetch_add(1, std::memory_order_relaxed);
+        replyJson(res, 413, false, fmt::format("a command is at most {} bytes", kMaxCommandBytes));
         return;
       }
       ControlRequest request;

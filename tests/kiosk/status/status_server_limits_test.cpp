@@ -317,5 +317,21 @@ TEST(StatusServerLimits, SnapshotsCostTheLoopOnePerPeriod) {
   EXPECT_LE(r.loop->snapshots(), static_cast<int>(periods) + 1) << ok << " snapshots served in " << seconds << " s";
 }
 
+// Makes sure a long command is refused before the frame loop sees it. Example failure: the
+// loop parses a megabyte, or the answer is 200.
+TEST(StatusServerLimits, ALongCommandIsRefusedBeforeParsing) {
+  Running r(spec());
+  httplib::Client client("127.0.0.1", r.port());
+  client.set_bearer_token_auth(kToken);
+  auto longOne = client.Post("/control/command", "echo " + std::string(kCommandBytes, 'x'), "text/plain");
+  ASSERT_TRUE(longOne);
+  EXPECT_EQ(longOne->status, 413) << longOne->body;
+  EXPECT_EQ(r.loop->controls(), 0) << "the command reached the frame loop";
+  auto shortOne = client.Post("/control/command", "echo " + std::string(kCommandBytes - 10, 'x'), "text/plain");
+  ASSERT_TRUE(shortOne);
+  EXPECT_EQ(shortOne->status, 200) << shortOne->body;
+  EXPECT_EQ(r.loop->controls(), 1);
+}
+
 }  // namespace
 }  // namespace basalt::kiosk
