@@ -10,13 +10,17 @@
 #include <httplib.h>
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 #include <future>
 #include <thread>
 #include <vector>
@@ -30,10 +34,12 @@ namespace {
 using namespace std::chrono_literals;
 
 // kiosk/status/README.md, "Limits".
-constexpr std::size_t kBodyLimit = 16384;    // [status] max_request_bytes' default
-constexpr std::size_t kHeaderFields = 64;    // header fields in one request
-constexpr std::size_t kHeadBytes = 16384;    // request line and header fields
-constexpr int kPerClient = 4;                // connections open from one address
+constexpr std::size_t kBodyLimit = 16384;  // [status] max_request_bytes' default
+constexpr std::size_t kHeaderFields = 64;  // header fields in one request
+constexpr std::size_t kHeadBytes = 16384;  // request line and header fields
+constexpr int kPerClient = 4;
+constexpr std::size_t kReservedDescriptors =
+    64;  // descriptors always left to the show                // connections open from one address
 constexpr auto kRequestTimeout = 10s;        // a request from its first byte
 constexpr auto kSnapshotPeriod = 1s;         // the frame loop reads back at most once per period
 constexpr std::size_t kCommandBytes = 1024;  // POST /control/command
@@ -124,6 +130,28 @@ std::string readAnswer(int fd, std::chrono::milliseconds patience) {
   const auto until = std::chrono::steady_clock::now() + patience;
   char buffer[4096];
   while (std::chrono::steady_clock::now() < until) {
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, 50) <= 0) continue;
+    const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
+    if (n <= 0) break;
+    answer.append(buffer, static_cast<std::size_t>(n));
+  }
+  return answer;
+}
+
+/// One whole answer on `fd` (head and Content-Length bytes of body), leaving the connection
+/// open; what came when `patience` runs out otherwise.
+std::string readOneAnswer(int fd, std::chrono::milliseconds patience) {
+  std::string answer;
+  const auto until = std::chrono::steady_clock::now() + patience;
+  char buffer[4096];
+  while (std::chrono::steady_clock::now() < until) {
+    const std::size_t head = answer.find("\r\n\r\n");
+    if (head != std::string::npos) {
+      const std::size_t at = answer.find("Content-Length: ");
+      const std::size_t length = at < head ? std::stoul(answer.substr(at + 16)) : 0;
+      if (answer.size() >= head + 4 + length) break;
+    }
     pollfd p{fd, POLLIN, 0};
     if (::poll(&p, 1, 50) <= 0) continue;
     const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
@@ -283,6 +311,58 @@ TEST(StatusServerLimits, ConnectionsPastThePerClientLimitAreRefused) {
   }
   EXPECT_EQ(statusOf(again), 200) << again;
   for (const int fd : held) ::close(fd);
+}
+
+std::size_t openDescriptors() {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator("/proc/self/fd")) ++n;
+  return n;
+}
+
+// Makes sure HTTP clients cannot take the descriptors the show needs: with the process's limit
+// a little above what is open, connections (from distinct addresses, so that the per-client
+// limit plays no part) are refused once one more would leave fewer than the reserve, and the
+// show can still open files then. Example failure: every connection admitted until open()
+// fails with EMFILE, and saving the state with it.
+TEST(StatusServerLimits, TheShowKeepsItsDescriptors) {
+  Running r(spec());
+  rlimit saved{};
+  ASSERT_EQ(::getrlimit(RLIMIT_NOFILE, &saved), 0);
+  rlimit tight = saved;
+  tight.rlim_cur = openDescriptors() + kReservedDescriptors + 16;
+  ASSERT_LE(tight.rlim_cur, saved.rlim_max);
+  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &tight), 0);
+  std::vector<int> held;
+  int admitted = 0;
+  bool refused = false;
+  for (int i = 1; i <= 16 && !refused; ++i) {
+    const int fd = connectFrom(fmt::format("127.0.0.{}", i + 10).c_str(), r.port());
+    if (fd < 0) break;
+    held.push_back(fd);
+    sendAll(fd, "GET /health HTTP/1.1\r\nHost: x\r\n\r\n");
+    const std::string answer = readOneAnswer(fd, 10s);
+    if (statusOf(answer) == 503) {
+      refused = true;
+    } else if (statusOf(answer) == 200) {
+      ++admitted;
+    }
+  }
+  // What the show still has: it can open files up to the reserve (less this test's own sockets).
+  const std::size_t free = tight.rlim_cur - openDescriptors();
+  std::vector<int> files;
+  for (std::size_t i = 0; i + 8 < kReservedDescriptors; ++i) {
+    const int fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+    if (fd < 0) break;
+    files.push_back(fd);
+  }
+  const std::size_t opened = files.size();
+  for (const int fd : files) ::close(fd);
+  for (const int fd : held) ::close(fd);
+  ::setrlimit(RLIMIT_NOFILE, &saved);
+  EXPECT_TRUE(refused) << admitted << " connections admitted, none refused";
+  EXPECT_GE(admitted, 1);
+  EXPECT_GE(free + 2 * held.size(), kReservedDescriptors) << "HTTP left the show fewer than the reserve";
+  EXPECT_EQ(opened, kReservedDescriptors - 8) << "the show could not open its files";
 }
 
 // Makes sure many clients asking for /snapshot.png cost the frame loop at most one read-back
