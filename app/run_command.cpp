@@ -759,6 +759,7 @@ int runShow(const RunOptions& options) {
 
   runtime::Show show;
   FrameLoop frameLoop({fps, maxFrames}, clock, manual ? &manualClock : nullptr, **loop, show, **output, **renderer);
+  board.setFrameWatch(frameLoop.watch());  // /health says when the loop is stuck
   ShowDirector director(
       DirectorContext{clock, **loop, show, **renderer, **output, board, events, supervisor.get(), state.get(), fps},
       std::move(factories));

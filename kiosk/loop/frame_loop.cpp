@@ -153,7 +153,13 @@ Result<FrameLoopStats> FrameLoop::run() {
     const bool last =
         stopRequested_ || participantWantsStop() || (config_.maxFrames >= 0 && drawn + 1 == config_.maxFrames);
     FrameContext context{frame, due, last};
-    if (auto r = renderFrame(context); !r) return std::unexpected(r.error());
+    // From here to the participants' afterPresent the loop works for this frame: a watcher
+    // that sees it busy too long knows the loop is stuck (waiting for the due time is not).
+    watch_.frameBegan(frame, wall.now());
+    if (auto r = renderFrame(context); !r) {
+      watch_.frameEnded();
+      return std::unexpected(r.error());
+    }
     if (drawn == 0) stats.firstFrameSeconds = toSeconds(wall.now() - wallStart);
     ++drawn;
     stats.frames = drawn;
@@ -162,6 +168,7 @@ Result<FrameLoopStats> FrameLoop::run() {
     show_.performance().recordFrame(renderer_.takeFrameCounts(), wall.now());
     show_.advanceFrame();
     for (FrameParticipant* p : participants_) p->afterPresent(context);
+    watch_.frameEnded();
     if (context.last) break;
   }
   stats.wallSeconds = toSeconds(wall.now() - wallStart);

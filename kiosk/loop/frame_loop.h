@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "kiosk/loop/frame_watch.h"
 #include "render/output.h"
 #include "render/renderer.h"
 #include "runtime/bounded_queue.h"
@@ -137,6 +138,8 @@ class FrameLoop {
   Result<FrameLoopStats> run();
   /// \brief Asks the loop to finish the next frame and return (safe from loop callbacks).
   void requestStop() { stopRequested_ = true; }
+  /// \brief The frame in progress, for watchers on other threads (the status board).
+  [[nodiscard]] const FrameWatch& watch() const { return watch_; }
 
  private:
   /// Waits, serving the event loop, until the output can take the next frame (paced outputs).
@@ -157,6 +160,7 @@ class FrameLoop {
   ViewDrawer* viewDrawer_ = nullptr;
   FrameGate* gate_ = nullptr;
   bool stopRequested_ = false;
+  FrameWatch watch_;
 };
 
 }  // namespace basalt::kiosk

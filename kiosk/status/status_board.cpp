@@ -4,6 +4,8 @@
 #include <atomic>
 #include <cmath>
 
+#include <fmt/format.h>
+
 namespace basalt::kiosk {
 
 void ControlReply::answer(int httpStatus, std::string text) {
@@ -229,6 +231,15 @@ StatusSnapshot StatusBoard::snapshot(WallTime now) const {
     s.lastReload = lastReload_;
     s.problems = problems_;
     if (!reloadProblem_.empty()) s.problems.push_back(reloadProblem_);
+    if (const auto busy = frameWatch_ ? frameWatch_->busy() : std::nullopt) {
+      const Nanos running = SystemClock().now() - busy->since;
+      if (running >= kStuckFrameAfter) {
+        s.problems.push_back(fmt::format(
+            "the frame loop has been stuck in frame {} for {:.0f} s: something it called does not return; the "
+            "service manager's watchdog restarts Basalt if it stays stuck",
+            busy->frame, toSeconds(running)));
+      }
+    }
     s.performance = performance_;
     s.lock = lock_;
   }

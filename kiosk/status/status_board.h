@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "kiosk/lock/lock_figures.h"
+#include "kiosk/loop/frame_watch.h"
 #include "kiosk/policy/schedule.h"
 #include "kiosk/status/machine_facts.h"
 #include "runtime/bounded_queue.h"
@@ -165,6 +166,10 @@ struct SnapshotRequest {
   bool wait(std::chrono::milliseconds timeout);
 };
 
+/// \brief A frame that takes this long is reported as the frame loop being stuck (a 60 Hz frame
+/// takes 17 ms; loading and reloading run off the loop's thread).
+inline constexpr std::chrono::seconds kStuckFrameAfter{3};
+
 /// \brief The meeting point of the frame loop and the status server.
 ///
 /// Threading: record*/publish*/set* come from the frame loop's thread; snapshot() and the
@@ -206,6 +211,10 @@ class StatusBoard {
   BoundedQueue<std::shared_ptr<SnapshotRequest>>& snapshotRequests() { return snapshots_; }
   /// \brief The show's Clock, whose calendar time the schedule is read in (any thread reads it).
   void setShowClock(const Clock& clock) { showClock_ = &clock; }
+  /// \brief The frame loop's progress (borrowed, set before the server starts): a frame busy
+  /// for kStuckFrameAfter or longer makes snapshot() report a problem, so `/health` is
+  /// "degraded" while the loop is stuck.
+  void setFrameWatch(const FrameWatch& watch) { frameWatch_ = &watch; }
   /// \brief A folder whose file system's free space the page shows ("state"); set before the
   /// server starts. The show's own folder is added by the server.
   void watchFolder(std::string name, std::filesystem::path path) {
@@ -255,6 +264,7 @@ class StatusBoard {
   std::string reloadProblem_;               // guarded by mutex_
   std::function<void()> wake_;              // set before the server starts
   const Clock* showClock_ = nullptr;        // set before the server starts
+  const FrameWatch* frameWatch_ = nullptr;  // set before the server starts
   std::vector<FolderToWatch> folders_;      // set before the server starts
   std::shared_ptr<log::RingSink> ring_;
   std::shared_ptr<CountingSink> counter_;

@@ -4,7 +4,6 @@
 #include "kiosk/status/status_server.h"
 
 #include <arpa/inet.h>
-#include <httplib.h>
 #include <netinet/in.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
@@ -25,6 +24,7 @@
 #include <fmt/std.h>
 #include <nlohmann/json.hpp>
 
+#include "kiosk/status/guarded_http_server.h"
 #include "media/image_io.h"
 #include "runtime/log.h"
 
@@ -35,6 +35,17 @@ BASALT_LOG_CATEGORY(Status, "kiosk");
 namespace {
 
 constexpr auto kAnswerWait = std::chrono::seconds(3);
+/// The frame loop reads a snapshot back at most once per period, however many clients ask.
+constexpr auto kSnapshotPeriod = std::chrono::seconds(1);
+/// A script command from the network is refused past this length before anything parses it.
+constexpr std::size_t kMaxCommandBytes = 1024;
+
+/// The limits of kiosk/status/README.md, with the show's body size.
+HttpLimits limitsFor(const StatusSpec& spec) {
+  HttpLimits limits;
+  limits.maxBodyBytes = spec.maxRequestBytes;
+  return limits;
+}
 
 std::string trim(std::string s) {
   while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
@@ -124,14 +135,29 @@ void replyJson(httplib::Response& res, int status, bool ok, std::string_view mes
 /// ContentReader and read only an announced body; an announced one is read whole, so that its
 /// bytes are not taken for the next request on the connection. Empty when it could not be read:
 /// `res.status` then says why (413, 400) and the error handler words the answer.
-std::optional<std::string> requestBody(const httplib::Request& req, const httplib::ContentReader& reader) {
+///
+/// At most `limit` bytes, whatever the transfer encoding: httplib checks a Content-Length against
+/// its payload limit but reads a chunked body to its end, so the receiver stops at the limit.
+std::optional<std::string> requestBody(const httplib::Request& req, httplib::Response& res,
+                                       const httplib::ContentReader& reader, std::size_t limit) {
   std::string body;
   if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) return body;
-  const bool read = reader([&body](const char* data, std::size_t length) {
+  bool tooLarge = false;
+  const bool read = reader([&body, &tooLarge, limit](const char* data, std::size_t length) {
+    if (body.size() + length > limit) {
+      tooLarge = true;
+      return false;
+    }
     body.append(data, length);
     return true;
   });
-  if (!read) return std::nullopt;
+  if (tooLarge) res.status = 413;
+  if (!read) {
+    // The rest of the body was not read: the connection cannot carry another request.
+    res.set_header("Connection", "close");
+    GuardedHttpServer::closeAfterAnswer();
+    return std::nullopt;
+  }
   return body;
 }
 
@@ -145,6 +171,56 @@ void yieldToTheShow() {
 }
 
 }  // namespace
+
+/// The frame on screen, read back by the frame loop at most once per kSnapshotPeriod: requests
+/// within a period share the last picture, and while one request waits for the loop the others
+/// wait for its answer rather than asking again. A failure is kept for the period too, so a hung
+/// loop is not asked again by every client.
+class StatusServer::SnapshotCache {
+ public:
+  struct Taken {
+    int status = 200;  // 200, or 500/503 with `error`
+    std::shared_ptr<const Image> image;
+    std::string error;
+  };
+
+  Taken get(StatusBoard& board) {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      if (last_ && std::chrono::steady_clock::now() - takenAt_ < kSnapshotPeriod) return *last_;
+      if (!asking_) break;
+      answered_.wait(lock);  // the asker waits kAnswerWait at most
+    }
+    asking_ = true;
+    lock.unlock();
+    Taken taken = ask(board);
+    lock.lock();
+    asking_ = false;
+    last_ = taken;
+    takenAt_ = std::chrono::steady_clock::now();
+    answered_.notify_all();
+    return taken;
+  }
+
+ private:
+  static Taken ask(StatusBoard& board) {
+    auto request = std::make_shared<SnapshotRequest>();
+    if (!board.snapshotRequests().push(request)) return {503, nullptr, "too many snapshots asked at once; try again"};
+    board.wake();
+    if (!request->wait(kAnswerWait)) {
+      return {503, nullptr, "the frame loop did not draw a frame within 3 s; it may be hung"};
+    }
+    std::lock_guard lock(request->mutex);
+    if (!request->ok) return {500, nullptr, request->error};
+    return {200, std::make_shared<const Image>(std::move(request->image)), {}};
+  }
+
+  std::mutex mutex_;  // guards everything below
+  std::condition_variable answered_;
+  bool asking_ = false;
+  std::optional<Taken> last_;
+  std::chrono::steady_clock::time_point takenAt_;
+};
 
 /// Token buckets per client address: `rate` requests a second, bursts of twice that.
 class StatusServer::Limiter {
@@ -182,8 +258,9 @@ StatusServer::StatusServer(const StatusSpec& spec, StatusBoard& board, std::stri
     : spec_(spec),
       board_(board),
       token_(std::move(token)),
-      server_(std::make_unique<httplib::Server>()),
-      limiter_(std::make_unique<Limiter>(spec.requestsPerSecond)) {}
+      server_(std::make_unique<GuardedHttpServer>(limitsFor(spec))),
+      limiter_(std::make_unique<Limiter>(spec.requestsPerSecond)),
+      snapshots_(std::make_unique<SnapshotCache>()) {}
 
 StatusServer::~StatusServer() {
   {
@@ -201,6 +278,8 @@ StatusServer::~StatusServer() {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   thread_.join();
+  // The workers run handlers that use the limiter and the snapshot cache: they end first.
+  server_.reset();
 }
 
 std::string StatusServer::notUpBecause() const {
@@ -317,12 +396,9 @@ Result<std::unique_ptr<StatusServer>> StatusServer::start(const StatusSpec& spec
   }
   server->routes();
   httplib::Server& http = *server->server_;
-  http.new_task_queue = [] { return new httplib::ThreadPool(2); };
+  // Threads, time-outs and keep-alive are GuardedHttpServer's (HttpLimits); httplib still
+  // checks a Content-Length against the body limit.
   http.set_payload_max_length(spec.maxRequestBytes);
-  http.set_read_timeout(5, 0);
-  http.set_write_timeout(5, 0);
-  http.set_keep_alive_max_count(20);
-  http.set_keep_alive_timeout(5);
   // httplib's default sets SO_REUSEPORT, with which a second process binds the same port and
   // the kernel hands it half the connections. SO_REUSEADDR alone lets a restart bind at once
   // past connections in TIME_WAIT, and a port in use stays refused.
@@ -347,7 +423,7 @@ Result<std::unique_ptr<StatusServer>> StatusServer::start(const StatusSpec& spec
 }
 
 void StatusServer::routes() {
-  httplib::Server& http = *server_;
+  GuardedHttpServer& http = *server_;
   http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     yieldToTheShow();
     requests_.fetch_add(1, std::memory_order_relaxed);
@@ -379,6 +455,13 @@ void StatusServer::routes() {
     return httplib::Server::HandlerResponse::Unhandled;
   });
   http.set_error_handler([this](const httplib::Request& req, httplib::Response& res) {
+    // A request that was not all there in time reaches httplib as a failed read (400).
+    if (res.status == 400 && GuardedHttpServer::currentRequestTimedOut()) res.status = 408;
+    if (res.status == 400 || res.status == 408 || res.status == 413) {
+      // What is left of the request is not a request: close after answering.
+      res.set_header("Connection", "close");
+      GuardedHttpServer::closeAfterAnswer();
+    }
     if (res.status == 413) rejectedSize_.fetch_add(1, std::memory_order_relaxed);
     if (!res.body.empty()) return;
     switch (res.status) {
@@ -388,6 +471,11 @@ void StatusServer::routes() {
         break;
       case 400: replyJson(res, 400, false, "malformed request"); break;
       case 414: replyJson(res, 414, false, "request line too long"); break;
+      case 408:
+        replyJson(res, 408, false,
+                  fmt::format("the request was not all there within {} s",
+                              std::chrono::duration<double>(server_->limits().requestTimeout).count()));
+        break;
       default: replyJson(res, res.status, false, fmt::format("HTTP status {}", res.status)); break;
     }
   });
@@ -432,22 +520,12 @@ void StatusServer::routes() {
       }
       width = value;
     }
-    auto request = std::make_shared<SnapshotRequest>();
-    if (!board_.snapshotRequests().push(request)) {
-      replyJson(res, 503, false, "too many snapshots asked at once; try again");
+    const SnapshotCache::Taken taken = snapshots_->get(board_);
+    if (taken.status != 200) {
+      replyJson(res, taken.status, false, taken.error);
       return;
     }
-    board_.wake();
-    if (!request->wait(kAnswerWait)) {
-      replyJson(res, 503, false, "the frame loop did not draw a frame within 3 s; it may be hung");
-      return;
-    }
-    std::lock_guard lock(request->mutex);
-    if (!request->ok) {
-      replyJson(res, 500, false, request->error);
-      return;
-    }
-    auto png = media::encodePng(width ? scaleDown(request->image, width) : request->image);
+    auto png = media::encodePng(width ? scaleDown(*taken.image, width) : *taken.image);
     if (!png) {
       replyJson(res, 500, false, png.error().describe());
       return;
@@ -459,7 +537,7 @@ void StatusServer::routes() {
   const auto control = [this](ControlKind kind, bool needsArgument) {
     return [this, kind, needsArgument](const httplib::Request& req, httplib::Response& res,
                                        const httplib::ContentReader& reader) {
-      const std::optional<std::string> body = requestBody(req, reader);
+      const std::optional<std::string> body = requestBody(req, res, reader, spec_.maxRequestBytes);
       if (!body) return;
       if (token_.empty()) {
         rejectedAuth_.fetch_add(1, std::memory_order_relaxed);
@@ -476,6 +554,12 @@ void StatusServer::routes() {
       if (!auth.starts_with("Bearer ") || !sameSecret(token_, std::string_view(auth).substr(7))) {
         rejectedAuth_.fetch_add(1, std::memory_order_relaxed);
         replyJson(res, 403, false, "wrong token");
+        return;
+      }
+      if (kind == ControlKind::kRunCommand && body->size() > kMaxCommandBytes) {
+        // Refused before anything parses it: a command is one line of a script.
+        rejectedSize_.fetch_add(1, std::memory_order_relaxed);
+        replyJson(res, 413, false, fmt::format("a command is at most {} bytes", kMaxCommandBytes));
         return;
       }
       ControlRequest request;
@@ -534,10 +618,10 @@ void StatusServer::routes() {
       replyJson(res, 405, false, fmt::format("use {}", allowed));
     };
   };
-  const auto withBody = [methodNotAllowed](std::string_view allowed) {
-    return [answer = methodNotAllowed(allowed)](const httplib::Request& req, httplib::Response& res,
-                                                const httplib::ContentReader& reader) {
-      if (requestBody(req, reader)) answer(req, res);
+  const auto withBody = [this, methodNotAllowed](std::string_view allowed) {
+    return [this, answer = methodNotAllowed(allowed)](const httplib::Request& req, httplib::Response& res,
+                                                      const httplib::ContentReader& reader) {
+      if (requestBody(req, res, reader, spec_.maxRequestBytes)) answer(req, res);
     };
   };
   for (const char* path : {"/health", "/metrics", "/snapshot.png", "/log.txt", "/"}) {
@@ -553,9 +637,9 @@ void StatusServer::routes() {
     http.Patch(path, withBody("POST"));
     http.Delete(path, withBody("POST"));
   }
-  const auto noSuchPage = [](const httplib::Request& req, httplib::Response& res,
-                             const httplib::ContentReader& reader) {
-    if (requestBody(req, reader)) {
+  const auto noSuchPage = [this](const httplib::Request& req, httplib::Response& res,
+                                 const httplib::ContentReader& reader) {
+    if (requestBody(req, res, reader, spec_.maxRequestBytes)) {
       replyJson(res, 404, false, fmt::format("no such page: {}; see / for the status page", req.path));
     }
   };

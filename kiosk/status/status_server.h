@@ -20,11 +20,9 @@
 #include "kiosk/status/status_report.h"
 #include "runtime/error.h"
 
-namespace httplib {
-class Server;
-}
-
 namespace basalt::kiosk {
+
+class GuardedHttpServer;  // kiosk/status/guarded_http_server.h
 
 /// \brief An HTTP server on its own threads (one accepting, two answering).
 ///
@@ -62,6 +60,7 @@ class StatusServer {
   [[nodiscard]] ServerFacts facts() const { return {controlsEnabled(), spec_.snapshot, readGuarded_}; }
 
   class Limiter;
+  class SnapshotCache;
 
  private:
   StatusServer(const StatusSpec& spec, StatusBoard& board, std::string token);
@@ -83,8 +82,9 @@ class StatusServer {
   bool readGuarded_ = false;
   std::string readToken_;
   std::string readTokenProblem_;
-  std::unique_ptr<httplib::Server> server_;
+  std::unique_ptr<GuardedHttpServer> server_;
   std::unique_ptr<Limiter> limiter_;
+  std::unique_ptr<SnapshotCache> snapshots_;
   std::thread thread_;
   std::atomic<std::uint16_t> port_{0};
   std::atomic<bool> bound_{false};

@@ -1044,11 +1044,16 @@ std::uint16_t commandIndex(const CommandDef& def) { return static_cast<std::uint
 std::span<const CommandAlias> commandAliases() { return kAliases; }
 
 std::optional<std::string_view> closestMatch(std::string_view word, std::span<const std::string_view> candidates) {
-  if (word.empty()) return std::nullopt;
+  if (word.empty() || word.size() > kMaxSuggestedLength) return std::nullopt;
   const std::size_t limit = word.size() <= 4 ? 1 : (word.size() <= 9 ? 2 : 3);
   std::optional<std::string_view> best;
   std::size_t bestDistance = SIZE_MAX;
   for (std::string_view c : candidates) {
+    if (c.size() > kMaxSuggestedLength) continue;
+    // The distance is at least the difference in length: skip those that cannot be close (a
+    // partial attribute name is longer than the word by design).
+    const std::size_t apart = c.size() > word.size() ? c.size() - word.size() : word.size() - c.size();
+    if (apart > limit && !sameGroupPartialName(word, c)) continue;
     const std::size_t d = editDistance(word, c);
     const bool close = d <= limit || sameGroupPartialName(word, c);
     if (close && d < bestDistance) {

@@ -198,8 +198,13 @@ struct CommandAlias {
 };
 std::span<const CommandAlias> commandAliases();
 
+/// \brief Longest word closestMatch() compares: a longer word (or candidate) gets no suggestion,
+/// so that a command from the network costs the same small work whatever its length.
+inline constexpr std::size_t kMaxSuggestedLength = 64;
+
 /// \brief The most likely intended word among `candidates` for a misspelt `word` (compared
-/// without case), or nothing when none is close.
+/// without case), or nothing when none is close. Bounded: words and candidates longer than
+/// kMaxSuggestedLength are not compared, nor candidates whose length differs too much to be close.
 std::optional<std::string_view> closestMatch(std::string_view word, std::span<const std::string_view> candidates);
 /// \brief The command a misspelt name most likely meant.
 std::optional<std::string_view> suggestCommand(std::string_view name);

@@ -522,5 +522,17 @@ TEST(Suggestions, CloseMatchesOnly) {
   EXPECT_FALSE(suggestCommand("xyzzy").has_value());
 }
 
+// Makes sure suggestions are bounded: a word longer than the documented 64 characters gets none
+// (a command from the network may be up to 1024 bytes), and a near miss of 64 still gets one.
+// Example failure: a 1000-character word compared with every command name.
+TEST(Suggestions, LongWordsGetNone) {
+  const std::string longWord(65, 'a');
+  const std::string longChoice = std::string(63, 'a') + "b";
+  const std::string_view choices[] = {longChoice};
+  EXPECT_FALSE(closestMatch(longWord, choices).has_value()) << "two edits away, but longer than 64";
+  EXPECT_FALSE(suggestCommand(std::string(1000, 'x') + "translate").has_value());
+  EXPECT_EQ(closestMatch(std::string(64, 'a'), choices).value_or(""), longChoice);
+}
+
 }  // namespace
 }  // namespace basalt::script
