@@ -345,7 +345,8 @@ token_file = "token"
   };
   const auto newFrames = [&] {
     const auto before = show->get("/snapshot.png");
-    ::usleep(400000);
+    // The server reads the frame back at most once a second and answers from that copy between.
+    ::usleep(1300000);
     const auto after = show->get("/snapshot.png");
     return before.status == 200 && after.status == 200 && before.body != after.body;
   };
