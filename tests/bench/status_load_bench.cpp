@@ -329,12 +329,17 @@ int main(int argc, char** argv) {
                 quiet.late, loaded.late == 0 ? "met" : "NOT MET");
     const double growth = loaded.rssEndKb - loaded.rssStartKb;
     const double baseGrowth = quiet.rssEndKb - quiet.rssStartKb;
-    // Flat: it grew no more than the quiet run did, give or take 1 MB of allocator noise.
+    // Flat: in the second half, once the server's workers, buffers and snapshot copy exist, it
+    // grew no more than the quiet run did, give or take 1 MB of allocator noise. A leak goes on
+    // growing there; a working set taken on at the start of the flood does not.
+    const double lateGrowth = loaded.rssEndKb - loaded.rssMidKb;
+    const double baseLateGrowth = quiet.rssEndKb - quiet.rssMidKb;
     std::printf(
-        "status flood: resident memory under load: target flat, measured %+.0f kB over %d s (%+.2f%%); baseline "
-        "%+.0f kB: %s\n",
-        growth, loadSeconds(), growth / loaded.rssStartKb * 100, baseGrowth,
-        growth <= std::max(baseGrowth, 0.0) + 1024 ? "met" : "NOT MET");
+        "status flood: resident memory under load: target flat, measured %+.0f kB in the second half (baseline "
+        "%+.0f kB): %s; over all %d s %+.0f kB (%+.2f%%; baseline %+.0f kB), the server's working set under the "
+        "flood included\n",
+        lateGrowth, baseLateGrowth, lateGrowth <= std::max(baseLateGrowth, 0.0) + 1024 ? "met" : "NOT MET",
+        loadSeconds(), growth, growth / loaded.rssStartKb * 100, baseGrowth);
     std::printf("status flood: frame loop CPU per frame under load %.3f ms vs %.3f ms without (%+.1f%%)\n",
                 loaded.loopCpuMs, quiet.loopCpuMs, (loaded.loopCpuMs / quiet.loopCpuMs - 1) * 100);
   });
