@@ -217,9 +217,12 @@ Figures play(int seconds, bool flood) {
   out.rssStartKb = procStatusKb(show.pid(), "VmRSS");
   std::optional<basalt::test::Process> load;
   if (flood) {
-    load.emplace(
-        basalt::test::Process::start({wrk, "-t2", "-c16", "-d" + std::to_string(seconds) + "s", "--timeout", "5s", "-s",
-                                      writeWrkScript().string(), "http://127.0.0.1:" + std::to_string(port) + "/"}));
+    // The flood's client stands for a machine elsewhere on the network; here it shares the show's
+    // cores, so it runs at the lowest priority: what the show then loses is what answering costs
+    // it, not what wrk's own work does.
+    load.emplace(basalt::test::Process::start(
+        {"/usr/bin/nice", "-n", "19", wrk, "-t2", "-c16", "-d" + std::to_string(seconds) + "s", "--timeout", "5s", "-s",
+         writeWrkScript().string(), "http://127.0.0.1:" + std::to_string(port) + "/"}));
   }
   // Readings every 5 s; waiting on the show's output keeps its pipe drained meanwhile.
   std::vector<double> p50, p99, max;
