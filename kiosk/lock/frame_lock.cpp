@@ -302,7 +302,9 @@ struct FrameLock::Impl {
                              peer));
         } else {
           refuse(&LockRejections::handshake, 2,
-                 fmt::format("frame lock: a handshake on {} broke off (not a frame-lock peer, or cut short)", peer));
+                 fmt::format("frame lock: a handshake on {} broke off (not a frame-lock peer, or cut short; "
+                             "ZeroMQ event {:#x}, {:#x})",
+                             peer, kind, value));
         }
       }
     }
@@ -1107,25 +1109,37 @@ FrameLockFigures FrameLock::figures() const {
 
 std::string FrameLock::describe() const {
   const FrameLockFigures f = figures();
+  const LockRejections& r = f.rejected;
+  const std::string refused = fmt::format(
+      "; {}, {} refused (no key {}, wrong key {}, handshake {}, frame jump {}, out of sequence {}, followers full {})",
+      f.authenticated ? "authenticated" : "unauthenticated", r.total(), r.noKey, r.wrongKey, r.handshake, r.frameJump,
+      r.outOfSequence, r.followersFull);
   if (f.leader) {
     return fmt::format(
-        "frame lock: leader '{}': {} followers in the barrier ({} known), {} frames presented without every answer, "
-        "{} dropped, {} rejoined, {} late answers, barrier wait median {:.3f} ms max {:.3f} ms, largest follower "
-        "clock offset {} us, {} malformed messages, {} programme changes sent, {} commands sent, {} re-sent",
-        f.node, f.followers, f.followersKnown, f.barrierTimeouts, f.followersDropped, f.followersRejoined,
-        f.lateAnswers, f.barrierWaitP50Ms, f.barrierWaitMaxMs, f.maxClockOffsetUs, f.malformed, f.programmeChanges,
-        f.commandsApplied, f.commandsResent);
+               "frame lock: leader '{}': {} followers in the barrier ({} known), {} frames presented without every "
+               "answer, "
+               "{} dropped, {} rejoined, {} late answers, barrier wait median {:.3f} ms max {:.3f} ms, largest "
+               "follower "
+               "clock offset {} us, {} malformed messages, {} programme changes sent, {} commands sent, {} re-sent",
+               f.node, f.followers, f.followersKnown, f.barrierTimeouts, f.followersDropped, f.followersRejoined,
+               f.lateAnswers, f.barrierWaitP50Ms, f.barrierWaitMaxMs, f.maxClockOffsetUs, f.malformed,
+               f.programmeChanges, f.commandsApplied, f.commandsResent) +
+           refused;
   }
   return fmt::format(
-      "frame lock: follower '{}': drew {} frames, {}..{}, checksum {:016x}, {} skipped, {} presented without the "
-      "leader's word, skew at most {} frames, leader lost {} times, clock offset {} us (largest {} us), delay median "
-      "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times (restarted {}), {} programme changes "
-      "followed, {} of "
-      "the leader's commands run ({} re-sent, {} lost), {} movie frames corrected to the leader's, {} late",
-      f.node, f.framesDrawn, f.firstFrame, f.lastFrame, f.frameChecksum, f.skipped, f.presentsMissed, f.maxSkewFrames,
-      f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs, f.malformed, f.leaderReturned,
-      f.leaderRestarts, f.programmeChanges, f.commandsApplied, f.commandsResent, f.commandsLost, f.movieFramesCorrected,
-      f.movieFramesLate);
+             "frame lock: follower '{}': drew {} frames, {}..{}, checksum {:016x}, {} skipped, {} presented without "
+             "the "
+             "leader's word, skew at most {} frames, leader lost {} times, clock offset {} us (largest {} us), delay "
+             "median "
+             "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times (restarted {}), {} programme "
+             "changes "
+             "followed, {} of "
+             "the leader's commands run ({} re-sent, {} lost), {} movie frames corrected to the leader's, {} late",
+             f.node, f.framesDrawn, f.firstFrame, f.lastFrame, f.frameChecksum, f.skipped, f.presentsMissed,
+             f.maxSkewFrames, f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs,
+             f.malformed, f.leaderReturned, f.leaderRestarts, f.programmeChanges, f.commandsApplied, f.commandsResent,
+             f.commandsLost, f.movieFramesCorrected, f.movieFramesLate) +
+         refused;
 }
 
 }  // namespace basalt::kiosk
