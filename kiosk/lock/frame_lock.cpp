@@ -614,19 +614,23 @@ struct FrameLock::Impl {
             ++figures.malformed;
           }
           break;
-        case LockMessageKind::kPresent:
-          if (auto p = decodePresent(message); p && p->frame > newestFrame) {
+        case LockMessageKind::kPresent: {
+          auto p = decodePresent(message);
+          if (p && newestFrame >= 0 && p->frame > newestFrame) {
             // The leader presents only frames it sent before, on this socket, in order.
             refuse(&LockRejections::outOfSequence, 4,
                    fmt::format("frame lock: 'present {}' before that frame (newest {})", p->frame, newestFrame));
-          } else if (p) {
-            heard();
+            break;
+          }
+          // A present, the join beacon (present -1, which does not decode), or a present heard
+          // before any frame (joined between a frame and its present: not ours to present).
+          heard();
+          if (p && newestFrame >= 0) {
             presented = std::max(presented, p->frame);
             newestPresented = std::max(newestPresented, p->frame);
-          } else {
-            heard();  // the join beacon (present -1)
           }
           break;
+        }
         case LockMessageKind::kBye:
           heard();
           byeSeen = true;
