@@ -5,9 +5,17 @@
 // most `timeout_ms` per frame, a follower's wait for "present" at most `leader_timeout_ms`.
 // Over TCP a lost packet is a retransmission, so loss shows as delay: late answers, frames a
 // follower skips and presents without the leader's word, all counted.
+//
+// With `lock.key_file` every socket speaks ZeroMQ's CURVE (libzmq is built with libsodium):
+// the leader's sockets are CURVE servers, a follower's CURVE clients, and both key pairs are
+// derived from the group's shared secret with libsodium (BLAKE2b, then X25519), so one file
+// on every node is the whole configuration. A ZAP handler on the leader admits only clients
+// with the group's public key; a socket monitor counts the handshakes that fail (no key, another
+// key, a replayed capture). See docs/decisions/XXXX-frame-lock-curve.md.
 
 #include "kiosk/lock/frame_lock.h"
 
+#include <sodium.h>
 #include <zmq.h>
 
 #include <algorithm>
@@ -16,6 +24,7 @@
 #include <cstring>
 #include <map>
 #include <random>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -54,7 +63,81 @@ Result<ZmqSocket> makeSocket(void* context, int type, std::string_view what) {
   return s;
 }
 
-std::string endpoint(std::string_view host, int port) { return fmt::format("tcp://{}:{}", host, port); }
+std::string endpoint(std::string_view host, int port) {
+  // An IPv6 literal goes in brackets (ZeroMQ's tcp://[::1]:port).
+  if (host.find(':') != std::string_view::npos) return fmt::format("tcp://[{}]:{}", host, port);
+  return fmt::format("tcp://{}:{}", host, port);
+}
+
+/// The group's CURVE key pairs (Curve25519), derived from its shared secret.
+struct LockKeys {
+  using Key = std::array<unsigned char, 32>;
+  Key leaderPublic{};
+  Key leaderSecret{};
+  Key followerPublic{};
+  Key followerSecret{};
+};
+
+/// Derives both key pairs from the secret: a BLAKE2b hash of it, then one BLAKE2b keyed by that
+/// hash per role (the role's name as the message) gives the secret key, and X25519's base point
+/// multiplication its public key. Every node derives the same pairs from the same file.
+Result<LockKeys> deriveKeys(std::string_view secret) {
+  if (sodium_init() < 0) return fail(Errc::kUnavailable, "frame lock: libsodium does not start");
+  static_assert(crypto_generichash_BYTES == 32 && crypto_scalarmult_BYTES == 32);
+  LockKeys::Key master{};
+  crypto_generichash(master.data(), master.size(), reinterpret_cast<const unsigned char*>(secret.data()), secret.size(),
+                     nullptr, 0);
+  LockKeys keys;
+  const auto derive = [&master](std::string_view role, LockKeys::Key& secretKey, LockKeys::Key& publicKey) {
+    crypto_generichash(secretKey.data(), secretKey.size(), reinterpret_cast<const unsigned char*>(role.data()),
+                       role.size(), master.data(), master.size());
+    return crypto_scalarmult_base(publicKey.data(), secretKey.data()) == 0;
+  };
+  const bool ok = derive("basalt frame lock v1: leader", keys.leaderSecret, keys.leaderPublic) &&
+                  derive("basalt frame lock v1: follower", keys.followerSecret, keys.followerPublic);
+  sodium_memzero(master.data(), master.size());
+  if (!ok) return fail(Errc::kInternal, "frame lock: a derived key is not a usable Curve25519 key");
+  return keys;
+}
+
+/// Makes `socket` a CURVE server (the leader's) or client (a follower's) of the group.
+Result<void> secure(void* socket, bool server, const LockKeys& keys) {
+  const auto set = [socket](int option, const void* value, std::size_t size) {
+    return zmq_setsockopt(socket, option, value, size) == 0;
+  };
+  const int on = 1;
+  constexpr std::string_view kDomain = "basalt-lock";
+  const bool ok = server ? set(ZMQ_CURVE_SERVER, &on, sizeof on) &&
+                               set(ZMQ_CURVE_SECRETKEY, keys.leaderSecret.data(), keys.leaderSecret.size()) &&
+                               set(ZMQ_ZAP_DOMAIN, kDomain.data(), kDomain.size())
+                         : set(ZMQ_CURVE_SERVERKEY, keys.leaderPublic.data(), keys.leaderPublic.size()) &&
+                               set(ZMQ_CURVE_PUBLICKEY, keys.followerPublic.data(), keys.followerPublic.size()) &&
+                               set(ZMQ_CURVE_SECRETKEY, keys.followerSecret.data(), keys.followerSecret.size());
+  if (!ok) {
+    return failf(Errc::kUnsupported, "frame lock: cannot use CURVE security: {} (is libzmq built with libsodium?)",
+                 zmq_strerror(zmq_errno()));
+  }
+  return {};
+}
+
+/// One frame of a multi-part message, read whole whatever its size.
+class ZmqMessage {
+ public:
+  ZmqMessage() { zmq_msg_init(&msg_); }
+  ~ZmqMessage() { zmq_msg_close(&msg_); }
+  ZmqMessage(const ZmqMessage&) = delete;
+  ZmqMessage& operator=(const ZmqMessage&) = delete;
+  ZmqMessage(ZmqMessage&&) = delete;
+  ZmqMessage& operator=(ZmqMessage&&) = delete;
+  bool receive(void* socket, int flags) { return zmq_msg_recv(&msg_, socket, flags) >= 0; }
+  [[nodiscard]] std::string_view text() const {
+    return {static_cast<const char*>(zmq_msg_data(&msg_)), zmq_msg_size(&msg_)};
+  }
+  [[nodiscard]] bool more() const { return zmq_msg_more(&msg_) != 0; }
+
+ private:
+  mutable zmq_msg_t msg_{};  // zmq_msg_data and zmq_msg_more take a non-const message and do not change it
+};
 
 /// A fixed ring of samples in milliseconds (no allocation per frame), medians on demand.
 class Samples {
@@ -106,8 +189,15 @@ struct FrameLock::Impl {
   SystemClock ownClock;
   const Clock* shared = &ownClock;  // the clock every node reads alike (send and receive times)
   ZmqContext context;
-  ZmqSocket pub;      // leader: PUB; follower: SUB
-  ZmqSocket answers;  // leader: ROUTER; follower: DEALER
+  ZmqSocket pub;                       // leader: PUB; follower: SUB
+  ZmqSocket answers;                   // leader: ROUTER; follower: DEALER
+  std::optional<LockKeys> keys;        // the group's (lock.key_file); none: unauthenticated
+  ZmqSocket zap;                       // leader with a key: the ZAP handler (REP) admitting followers
+  std::array<ZmqSocket, 2> monitors;   // PAIR: handshake failures of `pub` and `answers`
+  std::array<bool, 6> reasonLogged{};  // a refusal's reason logged once (LockRejections' order)
+  std::int64_t sentFrame = -1;         // leader: the newest frame published
+  bool sequenceReported = false;       // an out-of-sequence burst is logged once
+  bool fullReported = false;           // refused followers are logged once per burst
   LockBuffer buffer{};
   FrameLockFigures figures;
   Samples barrierWait;
@@ -119,6 +209,8 @@ struct FrameLock::Impl {
   // Follower.
   std::optional<FrameMessage> pending;  // the newest frame received and not drawn yet
   std::int64_t current = -1;            // the frame being drawn
+  std::int64_t newestFrame = -1;        // the newest frame accepted from the leader
+  bool jumpReported = false;            // a burst of refused frame jumps is logged once
   std::int64_t newestPresented = -1;
   Nanos lastHeard{-1};
   bool byeSeen = false;
@@ -154,10 +246,109 @@ struct FrameLock::Impl {
     (void)zmq_send(socket, buffer.data(), n, ZMQ_DONTWAIT);
   }
 
+  // ---- Security: both roles ----
+
+  /// Counts a refusal and logs the first of each reason.
+  void refuse(std::int64_t LockRejections::* counter, std::size_t reason, std::string_view why) {
+    ++(figures.rejected.*counter);
+    if (reason < reasonLogged.size() && !std::exchange(reasonLogged.at(reason), true)) {
+      log::warn(kLogLock, "{} (refused and counted; /metrics basalt_lock_messages_rejected_total)", why);
+    }
+  }
+
+  /// Watches `socket`'s handshakes on a PAIR socket: the ones that fail are counted by reason.
+  Result<void> watch(std::size_t index, void* socket) {
+    const std::string at = fmt::format("inproc://basalt-lock-monitor-{}", index);
+    if (zmq_socket_monitor(socket, at.c_str(),
+                           ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL | ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL |
+                               ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) != 0) {
+      return failf(Errc::kUnavailable, "frame lock: cannot watch the handshakes: {}", zmq_strerror(zmq_errno()));
+    }
+    ZmqSocket pair(zmq_socket(context.get(), ZMQ_PAIR));
+    const int linger = 0;
+    if (pair) zmq_setsockopt(pair.get(), ZMQ_LINGER, &linger, sizeof linger);
+    if (!pair || zmq_connect(pair.get(), at.c_str()) != 0) {
+      return failf(Errc::kUnavailable, "frame lock: cannot watch the handshakes: {}", zmq_strerror(zmq_errno()));
+    }
+    monitors.at(index) = std::move(pair);
+    return {};
+  }
+
+  /// Counts the handshakes that failed since the last call: none of those peers reached the lock.
+  void takeHandshakeFailures() {
+    for (const ZmqSocket& monitor : monitors) {
+      if (!monitor) continue;
+      for (;;) {
+        ZmqMessage event;
+        if (!event.receive(monitor.get(), ZMQ_DONTWAIT)) break;
+        ZmqMessage address;  // the second part always follows the first
+        (void)address.receive(monitor.get(), 0);
+        const std::string_view head = event.text();
+        if (head.size() < 6) continue;
+        std::uint16_t kind = 0;
+        std::uint32_t value = 0;
+        std::memcpy(&kind, head.data(), sizeof kind);
+        std::memcpy(&value, head.data() + 2, sizeof value);
+        const std::string_view peer = address.text();
+        if (kind == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL && value == ZMQ_PROTOCOL_ERROR_ZMTP_MECHANISM_MISMATCH) {
+          refuse(&LockRejections::noKey, 0,
+                 fmt::format("frame lock: a peer on {} speaks {} the group's key", peer,
+                             keys ? "without" : "with a key, but this node has no lock.key_file; it is not"));
+        } else if ((kind == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL && value == ZMQ_PROTOCOL_ERROR_ZMTP_CRYPTOGRAPHIC) ||
+                   kind == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) {
+          refuse(&LockRejections::wrongKey, 1,
+                 fmt::format("frame lock: a peer on {} did not prove the group's key (another key_file, or a "
+                             "replayed capture)",
+                             peer));
+        } else {
+          refuse(&LockRejections::handshake, 2,
+                 fmt::format("frame lock: a handshake on {} broke off (not a frame-lock peer, or cut short; "
+                             "ZeroMQ event {:#x}, {:#x})",
+                             peer, kind, value));
+        }
+      }
+    }
+  }
+
+  /// Leader: answers the ZAP requests waiting (RFC 27): a CURVE client with the group's
+  /// follower key is admitted, any other refused (the monitor counts the refusal).
+  void serveZap() {
+    if (!zap) return;
+    for (;;) {
+      std::array<std::string, 7> part;
+      std::size_t parts = 0;
+      bool more = true;
+      while (more) {
+        ZmqMessage m;
+        if (!m.receive(zap.get(), parts == 0 ? ZMQ_DONTWAIT : 0)) return;
+        if (parts < part.size()) part.at(parts) = std::string(m.text());
+        ++parts;
+        more = m.more();
+      }
+      const std::string_view want(reinterpret_cast<const char*>(keys->followerPublic.data()),
+                                  keys->followerPublic.size());
+      const bool ok = parts >= 7 && part[0] == "1.0" && part[5] == "CURVE" && part[6] == want;
+      const std::array<std::string_view, 6> reply{
+          "1.0", part[1], ok ? "200" : "400", ok ? "OK" : "not the frame-lock group's key", "", ""};
+      for (std::size_t i = 0; i < reply.size(); ++i) {
+        (void)zmq_send(zap.get(), reply.at(i).data(), reply.at(i).size(), i + 1 < reply.size() ? ZMQ_SNDMORE : 0);
+      }
+    }
+  }
+
+  /// Everything a leader's wait serves: answers, ZAP requests and handshake failures.
+  void pollLeader(long ms) {
+    std::array<zmq_pollitem_t, 2> items{zmq_pollitem_t{answers.get(), 0, ZMQ_POLLIN, 0},
+                                        zmq_pollitem_t{zap.get(), 0, ZMQ_POLLIN, 0}};
+    (void)zmq_poll(items.data(), zap ? 2 : 1, ms);
+  }
+
   // ---- Leader ----
 
   /// Reads every answer waiting; returns true when one for `frame` completed the barrier.
   void takeAnswers(std::int64_t presenting) {
+    serveZap();
+    takeHandshakeFailures();
     for (;;) {
       std::array<char, 64> id{};
       const int idBytes = zmq_recv(answers.get(), id.data(), id.size(), ZMQ_DONTWAIT);
@@ -188,7 +379,13 @@ struct FrameLock::Impl {
           if (figures.malformed++ == 0) log::warn(kLogLock, "{}", resend.error().message());
           continue;
         }
-        resendCommands(std::string_view(id.data(), std::min(static_cast<std::size_t>(idBytes), id.size())), *resend);
+        const std::string_view from(id.data(), std::min(static_cast<std::size_t>(idBytes), id.size()));
+        if (!followers.contains(from)) {
+          refuse(&LockRejections::outOfSequence, 4,
+                 fmt::format("frame lock: a 'resend' from '{}', which is not an admitted follower", from));
+          continue;
+        }
+        resendCommands(from, *resend);
         continue;
       }
       auto ready = decodeReady(message);
@@ -196,8 +393,30 @@ struct FrameLock::Impl {
         if (figures.malformed++ == 0) log::warn(kLogLock, "{}", ready.error().message());
         continue;
       }
+      if (ready->frame > sentFrame) {
+        // A follower cannot have drawn a frame this leader has not sent: taking it would let
+        // the barrier go on without it.
+        ++figures.rejected.outOfSequence;
+        if (!std::exchange(sequenceReported, true)) {
+          log::warn(kLogLock,
+                    "frame lock: follower '{}' says it drew frame {}, but the newest frame sent is {}; "
+                    "refused (counted as out_of_sequence)",
+                    ready->nodeName(), ready->frame, sentFrame);
+        }
+        continue;
+      }
+      sequenceReported = false;
       const std::string name = ready->nodeName();
+      if (!followers.contains(name) && std::cmp_greater_equal(followers.size(), spec.maxFollowers)) {
+        ++figures.rejected.followersFull;
+        if (!std::exchange(fullReported, true)) {
+          log::warn(kLogLock, "frame lock: follower '{}' refused: this leader admits {} followers (lock.max_followers)",
+                    name, spec.maxFollowers);
+        }
+        continue;
+      }
       auto [it, isNew] = followers.try_emplace(name);
+      if (isNew) fullReported = false;
       Follower& f = it->second;
       if (isNew) {
         log::info(kLogLock, "follower '{}' joined at frame {}", name, ready->frame);
@@ -237,6 +456,7 @@ struct FrameLock::Impl {
     // The run's other movies write their own slots (after the director's: theirs win).
     for (const LockedMovies* other : movies) other->lockedMovieFrames(m.movies);
     m.session = session;
+    sentFrame = m.frame;
     send(pub.get(), encode(m, buffer));
   }
 
@@ -316,9 +536,8 @@ struct FrameLock::Impl {
     while (!allReady(frame)) {
       const Nanos left = deadline - wall.now();
       if (left <= Nanos{0}) break;
-      zmq_pollitem_t item{answers.get(), 0, ZMQ_POLLIN, 0};
       const auto ms = std::max<long>(1, static_cast<long>(std::chrono::ceil<std::chrono::milliseconds>(left).count()));
-      if (zmq_poll(&item, 1, ms) < 0 && zmq_errno() != EINTR) break;
+      pollLeader(ms);
       takeAnswers(frame);
     }
     barrierWait.add(millis(wall.now() - start));
@@ -353,6 +572,7 @@ struct FrameLock::Impl {
 
   /// Reads everything the leader sent; returns the newest "present" number seen (or -1).
   std::int64_t takeLeaderMessages() {
+    takeHandshakeFailures();
     std::int64_t presented = -1;
     for (;;) {
       std::array<std::byte, kMaxLockMessageBytes + 1> bytes{};
@@ -365,10 +585,24 @@ struct FrameLock::Impl {
         if (figures.malformed++ == 0) log::warn(kLogLock, "{}", kind.error().message());
         continue;
       }
-      heard();
       switch (*kind) {
         case LockMessageKind::kFrame:
           if (auto f = decodeFrame(message)) {
+            if (newestFrame >= 0 && f->frame > newestFrame + spec.maxFrameJump) {
+              // Refused, and not heard: a leader that only sends such frames is lost after
+              // leader_timeout_ms, and its frames are taken from their new numbers when it is back.
+              ++figures.rejected.frameJump;
+              if (!std::exchange(jumpReported, true)) {
+                log::warn(kLogLock,
+                          "frame lock: frame {} is {} frames past the newest ({}), more than lock.max_frame_jump "
+                          "({}); refused until the leader is heard again",
+                          f->frame, f->frame - newestFrame, newestFrame, spec.maxFrameJump);
+              }
+              break;
+            }
+            heard();
+            jumpReported = false;
+            newestFrame = std::max(newestFrame, f->frame);
             delay.add(millis(shared->now() - Nanos{f->sentNs}));
             // A newer frame replaces one not drawn yet: nextFrame() counts the gap as skipped.
             if (f->frame > current && (!pending || f->frame > pending->frame)) {
@@ -376,19 +610,35 @@ struct FrameLock::Impl {
               pending = *f;
             }
           } else {
+            heard();
             ++figures.malformed;
           }
           break;
-        case LockMessageKind::kPresent:
-          if (auto p = decodePresent(message)) {
+        case LockMessageKind::kPresent: {
+          auto p = decodePresent(message);
+          if (p && newestFrame >= 0 && p->frame > newestFrame) {
+            // The leader presents only frames it sent before, on this socket, in order.
+            refuse(&LockRejections::outOfSequence, 4,
+                   fmt::format("frame lock: 'present {}' before that frame (newest {})", p->frame, newestFrame));
+            break;
+          }
+          // A present, the join beacon (present -1, which does not decode), or a present heard
+          // before any frame (joined between a frame and its present: not ours to present).
+          heard();
+          if (p && newestFrame >= 0) {
             presented = std::max(presented, p->frame);
             newestPresented = std::max(newestPresented, p->frame);
           }
           break;
-        case LockMessageKind::kBye: byeSeen = true; break;
+        }
+        case LockMessageKind::kBye:
+          heard();
+          byeSeen = true;
+          break;
         case LockMessageKind::kReady:
         case LockMessageKind::kResend:
         case LockMessageKind::kCommand:
+          heard();
           ++figures.malformed;  // followers do not talk to each other; commands come on DEALER
           break;
       }
@@ -406,6 +656,7 @@ struct FrameLock::Impl {
                   toSeconds(wall.now() - lostAt));
         ++figures.leaderReturned;
         current = -1;
+        newestFrame = -1;
         newestPresented = -1;
         publishNow = true;
       }
@@ -550,6 +801,12 @@ struct FrameLock::Impl {
         continue;
       }
       if (!commandEpoch || m->epoch != *commandEpoch) continue;  // for a log the leader has ended
+      if (m->seq > commandsAnnounced) {
+        refuse(
+            &LockRejections::outOfSequence, 4,
+            fmt::format("frame lock: command {} re-sent, but the leader announced only {}", m->seq, commandsAnnounced));
+        continue;
+      }
       ++figures.commandsResent;
       if (m->earlierGone && m->seq > lastCommandRun + 1 && m->seq - 1 > commandBase) {
         const std::uint32_t from = std::max(lastCommandRun, commandBase) + 1;
@@ -695,6 +952,35 @@ Result<std::unique_ptr<FrameLock>> FrameLock::create(const LockSpec& spec, const
   if (!answers) return std::unexpected(answers.error());
   impl->pub = std::move(*pub);
   impl->answers = std::move(*answers);
+  if (!spec.keyFile.empty()) {
+    auto secret = readLockKey(spec.keyFile);
+    if (!secret) return failf(Errc::kPermissionDenied, "frame lock: {}", secret.error().message());
+    auto keys = deriveKeys(*secret);
+    sodium_memzero(secret->data(), secret->size());
+    if (!keys) return std::unexpected(keys.error());
+    impl->keys = *keys;
+    impl->figures.authenticated = true;
+    for (void* socket : {impl->pub.get(), impl->answers.get()}) {
+      if (auto r = secure(socket, leader, *impl->keys); !r) return std::unexpected(r.error());
+    }
+    if (leader) {
+      // The ZAP handler must be bound before the sockets take connections (RFC 27).
+      impl->zap.reset(zmq_socket(impl->context.get(), ZMQ_REP));
+      const int linger = 0;
+      if (impl->zap) zmq_setsockopt(impl->zap.get(), ZMQ_LINGER, &linger, sizeof linger);
+      if (!impl->zap || zmq_bind(impl->zap.get(), "inproc://zeromq.zap.01") != 0) {
+        return failf(Errc::kUnavailable, "frame lock: cannot start the ZAP handler: {}", zmq_strerror(zmq_errno()));
+      }
+    }
+  } else if (!spec.loopbackOnly()) {
+    log::warn(kLogLock,
+              "frame lock: unauthenticated: {} {} port {} without lock.key_file; anything that reaches the port can "
+              "freeze or steer the show (give every node the same key_file)",
+              leader ? "listening on" : "following the leader at", leader ? spec.listen : spec.leader, spec.port);
+  }
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (auto r = impl->watch(i, i == 0 ? impl->pub.get() : impl->answers.get()); !r) return std::unexpected(r.error());
+  }
   if (leader) {
     const int handover = 1;  // a restarted follower with the same name takes its place over
     zmq_setsockopt(impl->answers.get(), ZMQ_ROUTER_HANDOVER, &handover, sizeof handover);
@@ -756,8 +1042,7 @@ std::int64_t FrameLock::awaitFollowers(runtime::EventLoop& loop) {
       lastBeacon = wall.now();
       d.send(d.pub.get(), encode(PresentMessage{-1}, d.buffer));
     }
-    zmq_pollitem_t item{d.answers.get(), 0, ZMQ_POLLIN, 0};
-    (void)zmq_poll(&item, 1, 10);
+    d.pollLeader(10);
     d.takeAnswers(0);
     if (!loop.dispatch(Nanos{0})) break;
   }
@@ -828,25 +1113,37 @@ FrameLockFigures FrameLock::figures() const {
 
 std::string FrameLock::describe() const {
   const FrameLockFigures f = figures();
+  const LockRejections& r = f.rejected;
+  const std::string refused = fmt::format(
+      "; {}, {} refused (no key {}, wrong key {}, handshake {}, frame jump {}, out of sequence {}, followers full {})",
+      f.authenticated ? "authenticated" : "unauthenticated", r.total(), r.noKey, r.wrongKey, r.handshake, r.frameJump,
+      r.outOfSequence, r.followersFull);
   if (f.leader) {
     return fmt::format(
-        "frame lock: leader '{}': {} followers in the barrier ({} known), {} frames presented without every answer, "
-        "{} dropped, {} rejoined, {} late answers, barrier wait median {:.3f} ms max {:.3f} ms, largest follower "
-        "clock offset {} us, {} malformed messages, {} programme changes sent, {} commands sent, {} re-sent",
-        f.node, f.followers, f.followersKnown, f.barrierTimeouts, f.followersDropped, f.followersRejoined,
-        f.lateAnswers, f.barrierWaitP50Ms, f.barrierWaitMaxMs, f.maxClockOffsetUs, f.malformed, f.programmeChanges,
-        f.commandsApplied, f.commandsResent);
+               "frame lock: leader '{}': {} followers in the barrier ({} known), {} frames presented without every "
+               "answer, "
+               "{} dropped, {} rejoined, {} late answers, barrier wait median {:.3f} ms max {:.3f} ms, largest "
+               "follower "
+               "clock offset {} us, {} malformed messages, {} programme changes sent, {} commands sent, {} re-sent",
+               f.node, f.followers, f.followersKnown, f.barrierTimeouts, f.followersDropped, f.followersRejoined,
+               f.lateAnswers, f.barrierWaitP50Ms, f.barrierWaitMaxMs, f.maxClockOffsetUs, f.malformed,
+               f.programmeChanges, f.commandsApplied, f.commandsResent) +
+           refused;
   }
   return fmt::format(
-      "frame lock: follower '{}': drew {} frames, {}..{}, checksum {:016x}, {} skipped, {} presented without the "
-      "leader's word, skew at most {} frames, leader lost {} times, clock offset {} us (largest {} us), delay median "
-      "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times (restarted {}), {} programme changes "
-      "followed, {} of "
-      "the leader's commands run ({} re-sent, {} lost), {} movie frames corrected to the leader's, {} late",
-      f.node, f.framesDrawn, f.firstFrame, f.lastFrame, f.frameChecksum, f.skipped, f.presentsMissed, f.maxSkewFrames,
-      f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs, f.malformed, f.leaderReturned,
-      f.leaderRestarts, f.programmeChanges, f.commandsApplied, f.commandsResent, f.commandsLost, f.movieFramesCorrected,
-      f.movieFramesLate);
+             "frame lock: follower '{}': drew {} frames, {}..{}, checksum {:016x}, {} skipped, {} presented without "
+             "the "
+             "leader's word, skew at most {} frames, leader lost {} times, clock offset {} us (largest {} us), delay "
+             "median "
+             "{:.3f} ms max {:.3f} ms, {} malformed messages, leader back {} times (restarted {}), {} programme "
+             "changes "
+             "followed, {} of "
+             "the leader's commands run ({} re-sent, {} lost), {} movie frames corrected to the leader's, {} late",
+             f.node, f.framesDrawn, f.firstFrame, f.lastFrame, f.frameChecksum, f.skipped, f.presentsMissed,
+             f.maxSkewFrames, f.leaderLost, f.clockOffsetUs, f.maxClockOffsetUsSeen, f.delayP50Ms, f.delayMaxMs,
+             f.malformed, f.leaderReturned, f.leaderRestarts, f.programmeChanges, f.commandsApplied, f.commandsResent,
+             f.commandsLost, f.movieFramesCorrected, f.movieFramesLate) +
+         refused;
 }
 
 }  // namespace basalt::kiosk

@@ -9,10 +9,26 @@
 
 namespace basalt::kiosk {
 
+/// \brief What the lock refused, by reason (`basalt_lock_messages_rejected_total{reason}`): nothing
+/// it refuses changes the show.
+struct LockRejections {
+  std::int64_t noKey = 0;      ///< `no_key`: a peer that speaks without the CURVE handshake
+  std::int64_t wrongKey = 0;   ///< `wrong_key`: a handshake that proves no key of the group (another key, or replayed)
+  std::int64_t handshake = 0;  ///< `handshake`: a handshake that broke off otherwise (garbage, cut short)
+  std::int64_t frameJump = 0;  ///< `frame_jump`: a frame further ahead of the last drawn than lock.max_frame_jump
+  std::int64_t outOfSequence = 0;  ///< `out_of_sequence`: a number its sender cannot have reached yet
+  std::int64_t followersFull = 0;  ///< `followers_full`: a follower beyond lock.max_followers
+  [[nodiscard]] std::int64_t total() const {
+    return noKey + wrongKey + handshake + frameJump + outOfSequence + followersFull;
+  }
+};
+
 /// \brief The lock's figures, for the summary line, /health and /metrics.
 struct FrameLockFigures {
   bool leader = false;
   std::string node;
+  bool authenticated = false;  ///< every connection proves the group's key (lock.key_file)
+  LockRejections rejected;
   // Leader.
   std::int64_t followers = 0;          ///< followers in the barrier now
   std::int64_t followersKnown = 0;     ///< followers ever heard from

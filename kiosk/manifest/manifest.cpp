@@ -8,6 +8,9 @@
 #define TOML_EXCEPTIONS 0  // NOLINT(bugprone-macro-parentheses): toml++ configuration
 #include <toml++/toml.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -115,7 +118,38 @@ std::string_view outsideHoursName(OutsideHours outside) {
   return "?";
 }
 
-bool StatusSpec::loopbackOnly() const { return host == "localhost" || host == "::1" || host.starts_with("127."); }
+namespace {
+bool loopbackHost(std::string_view host) { return host == "localhost" || host == "::1" || host.starts_with("127."); }
+}  // namespace
+
+bool StatusSpec::loopbackOnly() const { return loopbackHost(host); }
+
+Result<std::string> readLockKey(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) return failf(Errc::kNotFound, "cannot read the frame-lock key file {}", file.string());
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string key = text.str();
+  const auto first = key.find_first_not_of(" \t\r\n");
+  const auto last = key.find_last_not_of(" \t\r\n");
+  key = first == std::string::npos ? std::string() : key.substr(first, last - first + 1);
+  if (key.size() < kLockKeyMinChars) {
+    return failf(Errc::kInvalidArgument,
+                 "the frame-lock key file {} holds {} characters, fewer than {}; make it with: openssl rand -hex 32 "
+                 "> {}",
+                 file.string(), key.size(), kLockKeyMinChars, file.string());
+  }
+  return key;
+}
+
+bool isAddress(std::string_view text) {
+  const std::string s(text);
+  in_addr v4{};
+  in6_addr v6{};
+  return ::inet_pton(AF_INET, s.c_str(), &v4) == 1 || ::inet_pton(AF_INET6, s.c_str(), &v6) == 1;
+}
+
+bool LockSpec::loopbackOnly() const { return loopbackHost(role == LockRole::kFollower ? leader : listen); }
 
 Manifest Manifest::builtinDefault() {
   Manifest m;
@@ -1935,7 +1969,7 @@ class Reader {
     l.line = lineOf(t);
     checkKeys(t, "lock",
               {"role", "node", "leader", "listen", "port", "followers", "join_timeout_ms", "timeout_ms", "drop_after",
-               "leader_timeout_ms", "clock"});
+               "leader_timeout_ms", "clock", "key_file", "max_followers", "max_frame_jump"});
     if (auto role =
             choice<LockRole>(t, "role", "lock", {{"leader", LockRole::kLeader}, {"follower", LockRole::kFollower}})) {
       l.role = *role;
@@ -1950,7 +1984,16 @@ class Reader {
       }
     }
     if (auto leader = string(t, "leader", "lock")) l.leader = *leader;
-    if (auto listen = string(t, "listen", "lock")) l.listen = *listen;
+    if (auto listen = string(t, "listen", "lock")) {
+      if (isAddress(*listen)) {
+        l.listen = *listen;
+      } else {
+        error(lineOf(*t.get("listen")),
+              fmt::format("lock.listen: '{}' is not an IP address; name one of this node's addresses (the one "
+                          "facing the followers), or \"0.0.0.0\" for every interface",
+                          *listen));
+      }
+    }
     if (auto port = integer(t, "port", "lock", 1, 65533)) l.port = static_cast<int>(*port);
     if (auto n = integer(t, "followers", "lock", 0, 256)) l.followers = static_cast<int>(*n);
     if (auto ms = integer(t, "join_timeout_ms", "lock", 0, 600000)) l.joinTimeoutMs = static_cast<int>(*ms);
@@ -1958,6 +2001,22 @@ class Reader {
     if (auto n = integer(t, "drop_after", "lock", 1, 10000)) l.dropAfter = static_cast<int>(*n);
     if (auto ms = integer(t, "leader_timeout_ms", "lock", 10, 600000)) l.leaderTimeoutMs = static_cast<int>(*ms);
     if (auto clock = boolean(t, "clock", "lock")) l.clock = *clock;
+    if (auto n = integer(t, "max_followers", "lock", 1, 256)) l.maxFollowers = static_cast<int>(*n);
+    if (auto n = integer(t, "max_frame_jump", "lock", 1, 1000000)) l.maxFrameJump = static_cast<int>(*n);
+    if (l.followers > l.maxFollowers) {
+      error(lineOf(*t.get("followers")),
+            fmt::format("lock.followers: {} is more than max_followers ({}); raise max_followers", l.followers,
+                        l.maxFollowers));
+    }
+    if (auto keyFile = string(t, "key_file", "lock")) readLockKeyFile(*keyFile, lineOf(*t.get("key_file")));
+    if (l.role != LockRole::kOff && l.keyFile.empty() && !l.loopbackOnly()) {
+      warning(t.get("listen") ? lineOf(*t.get("listen")) : l.line,
+              fmt::format("lock: {} '{}' without key_file: the frame lock is unauthenticated, and anything that "
+                          "reaches the port can freeze or steer the show; give every node the same key_file "
+                          "(make it with: openssl rand -hex 32 > lock.key; chmod 600 lock.key)",
+                          l.role == LockRole::kFollower ? "the leader at" : "listening on",
+                          l.role == LockRole::kFollower ? l.leader : l.listen));
+    }
     if (l.role == LockRole::kFollower && l.leader.empty()) {
       error(l.line, "lock: a follower needs leader = \"ADDRESS\" (the leader's IP address or host name)");
     }
@@ -1967,6 +2026,29 @@ class Reader {
     if (l.role == LockRole::kFollower && (t.get("followers") || t.get("timeout_ms") || t.get("drop_after"))) {
       warning(l.line, "lock: followers, timeout_ms and drop_after are the leader's; a follower ignores them");
     }
+  }
+
+  /// `lock.key_file`: a credential, so it may live outside the show folder; checked for being
+  /// there, long enough and readable only by its owner.
+  void readLockKeyFile(std::string_view file, int line) {
+    std::filesystem::path p(file);
+    if (p.is_relative()) p = folder_ / p;
+    manifest_.lock.keyFile = p;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(p, ec)) {
+      warning(line, fmt::format("lock.key_file: '{}' does not exist yet; the lock does not start until it does (make "
+                                "it with: openssl rand -hex 32 > {}; chmod 600 {})",
+                                file, p.string(), p.string()));
+      return;
+    }
+    using std::filesystem::perms;
+    const perms mode = std::filesystem::status(p, ec).permissions();
+    if (!ec && (mode & (perms::group_all | perms::others_all)) != perms::none) {
+      warning(line, fmt::format("lock.key_file: '{}' is readable by other users; make it the service's only (chmod "
+                                "600 {})",
+                                file, p.string()));
+    }
+    if (auto key = readLockKey(p); !key) error(line, fmt::format("lock.key_file: {}", key.error().message()));
   }
 
   // ---- [status] ----

@@ -332,19 +332,40 @@ struct InputSpec {
 /// \brief `[lock]`: frame-locked display nodes (thesis §4.5, kiosk/lock/frame_lock.h).
 enum class LockRole : std::uint8_t { kOff, kLeader, kFollower };
 
+/// The shortest frame-lock key (`lock.key_file`) accepted: 32 characters (`openssl rand -hex 32`
+/// writes 64).
+inline constexpr std::size_t kLockKeyMinChars = 32;
+
+/// \brief The frame-lock key in `file`: its text less surrounding white space, at least
+/// kLockKeyMinChars long; or why it is not there.
+[[nodiscard]] Result<std::string> readLockKey(const std::filesystem::path& file);
+
+/// \brief True for an IPv4 or IPv6 address literal.
+[[nodiscard]] bool isAddress(std::string_view text);
+
 struct LockSpec {
   LockRole role = LockRole::kOff;
-  std::string node;                ///< this node's name (default: the host name); unique in the group
-  std::string leader;              ///< follower: the leader's address (IP or host name)
-  std::string listen = "0.0.0.0";  ///< leader: the address its sockets listen on
-  int port = 5560;                 ///< frames on port, answers on port + 1, the network clock on port + 2
-  int followers = 0;               ///< leader: followers to wait for before the first frame
-  int joinTimeoutMs = 5000;        ///< leader: how long to wait for them
-  int timeoutMs = 20;              ///< leader: how long each frame waits for the followers' answers
-  int dropAfter = 3;               ///< leader: missed frames in a row before a follower leaves the barrier
-  int leaderTimeoutMs = 1000;      ///< follower: silence before the leader is reported lost
-  bool clock = true;               ///< share the leader's clock (GStreamer's network clock)
+  std::string node;    ///< this node's name (default: the host name); unique in the group
+  std::string leader;  ///< follower: the leader's address (IP or host name)
+  /// Leader: the address of this node its sockets (and the shared clock) listen on; loopback
+  /// unless the manifest names another, so that a lock is never open to every network by default.
+  std::string listen = "127.0.0.1";
+  /// The group's shared secret (`lock.key_file`, a credential like status.token_file): every
+  /// connection proves it with ZeroMQ's CURVE handshake. Empty: unauthenticated.
+  std::filesystem::path keyFile;
+  int maxFollowers = 16;       ///< leader: followers it admits; the extra are refused and counted
+  int maxFrameJump = 600;      ///< follower: a frame more than this ahead of the last drawn is refused
+  int port = 5560;             ///< frames on port, answers on port + 1, the network clock on port + 2
+  int followers = 0;           ///< leader: followers to wait for before the first frame
+  int joinTimeoutMs = 5000;    ///< leader: how long to wait for them
+  int timeoutMs = 20;          ///< leader: how long each frame waits for the followers' answers
+  int dropAfter = 3;           ///< leader: missed frames in a row before a follower leaves the barrier
+  int leaderTimeoutMs = 1000;  ///< follower: silence before the leader is reported lost
+  bool clock = true;           ///< share the leader's clock (GStreamer's network clock)
   int line = 0;
+  /// \brief True when the lock's sockets reach only this machine: the leader listens on, or the
+  /// follower connects to, a loopback address (127.0.0.0/8, ::1, "localhost").
+  [[nodiscard]] bool loopbackOnly() const;
 };
 
 /// \brief A whole show manifest, validated.

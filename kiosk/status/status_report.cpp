@@ -189,6 +189,14 @@ std::string healthJson(const StatusSnapshot& s) {
         {"clock_offset_us", l->leader ? l->maxClockOffsetUs : l->clockOffsetUs},
         {"delay_ms", {{"p50", rounded(l->delayP50Ms, 3)}, {"max", rounded(l->delayMaxMs, 3)}}},
         {"malformed", l->malformed},
+        {"authenticated", l->authenticated},
+        {"rejected",
+         {{"no_key", l->rejected.noKey},
+          {"wrong_key", l->rejected.wrongKey},
+          {"handshake", l->rejected.handshake},
+          {"frame_jump", l->rejected.frameJump},
+          {"out_of_sequence", l->rejected.outOfSequence},
+          {"followers_full", l->rejected.followersFull}}},
         {"holding", l->holding},
         {"holding_seconds", rounded(l->holdingSeconds, 1)},
         {"held_frame", l->heldFrame},
@@ -426,6 +434,19 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
                  number(static_cast<double>(l->clockOffsetUs) / 1e6));
     }
     lockMetric("basalt_lock_malformed_total", "counter", "Frame-lock messages rejected.", l->malformed);
+    lockMetric("basalt_lock_authenticated", "gauge", "1 when every frame-lock connection proves the group's key.",
+               l->authenticated ? 1 : 0);
+    metric("basalt_lock_messages_rejected_total", "counter",
+           "Frame-lock connections and messages refused, by reason; none of them changed the show.");
+    for (const auto& [reason, count] : {std::pair<std::string_view, std::int64_t>{"no_key", l->rejected.noKey},
+                                        {"wrong_key", l->rejected.wrongKey},
+                                        {"handshake", l->rejected.handshake},
+                                        {"frame_jump", l->rejected.frameJump},
+                                        {"out_of_sequence", l->rejected.outOfSequence},
+                                        {"followers_full", l->rejected.followersFull}}) {
+      out += fmt::format("basalt_lock_messages_rejected_total{{node=\"{}\",role=\"{}\",reason=\"{}\"}} {}\n",
+                         promLabel(l->node), l->leader ? "leader" : "follower", reason, count);
+    }
     lockMetric("basalt_lock_commands_applied_total", "counter",
                l->leader ? "Script commands the leader ran for the group." : "The leader's script commands run here.",
                l->commandsApplied);

@@ -31,6 +31,7 @@ instead of the leader's, or a leader that stops when a follower dies.
 
 import os
 import re
+import secrets
 import shutil
 import signal
 import subprocess
@@ -118,6 +119,10 @@ def write_show(folder, lock, clip=None):
         movie = ('[media.loop]\nkind = "movie"\nfile = "loop.mkv"\nloop = true\n\n'
                  '[textures.screen]\nsource = "loop"\n\n'
                  '[[kiosk.playlist]]\nname = "numbers"\nentry = "loop.mkv"\n\n')
+    # The group's key (lock.key_file), the same on every node, readable by its owner only.
+    key = os.path.join(folder, "lock.key")
+    with open(os.open(key, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600), "w") as f:
+        f.write(GROUP_KEY + "\n")
     with open(os.path.join(folder, "show.toml"), "w") as f:
         f.write('[show]\nname = "frame lock test"\nfps = 60\n\n[output]\nkind = "headless"\n\n' + movie +
                 '[lock]\n' + lock)
@@ -242,13 +247,20 @@ def wait(proc, seconds, log):
         raise AssertionError(f"{log} exited with {rc}:\n{open(log).read()[-3000:]}")
 
 
+# A fresh secret per run, as `openssl rand -hex 32` makes one.
+GROUP_KEY = secrets.token_hex(32)
+
+
 def leader_lock(timeout_ms, drop_after=3):
+    # The leader faces two followers on two links: it listens on every interface, with the key.
     return (f'role = "leader"\nnode = "leader"\nport = {PORT}\nfollowers = 2\njoin_timeout_ms = 20000\n'
+            f'listen = "0.0.0.0"\nkey_file = "lock.key"\n'
             f'timeout_ms = {timeout_ms}\ndrop_after = {drop_after}\n')
 
 
 def follower_lock(name, net):
-    return f'role = "follower"\nnode = "{name}"\nleader = "10.77.{net}.1"\nport = {PORT}\nleader_timeout_ms = 3000\n'
+    return (f'role = "follower"\nnode = "{name}"\nleader = "10.77.{net}.1"\nport = {PORT}\nleader_timeout_ms = 3000\n'
+            f'key_file = "lock.key"\n')
 
 
 def run_steady(basalt, work, frames, timeout_ms, label, strict=True, clip=None):

@@ -6,12 +6,25 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zmq.h>
+
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
+#include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -482,6 +495,7 @@ struct FollowerNode {
   std::vector<Mat4> globals;  // the show state drawn with each frame
   FrameLockFigures figures;
   std::string failure;
+  std::atomic<bool> quit{false};  // set by the test: stop waiting for frames
 
   void run(const LockSpec& spec, std::int64_t stopAfter = -1) {
     SystemClock clock;
@@ -496,7 +510,7 @@ struct FollowerNode {
     if (withMovies) (*lock)->addMovies(movies);
     NullOutput output;
     const auto giveUp = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (std::chrono::steady_clock::now() < giveUp) {
+    while (std::chrono::steady_clock::now() < giveUp && !quit) {
       auto next = (*lock)->nextFrame(**loop, std::chrono::milliseconds(100));
       if (!next) {
         failure = next.error().message();
@@ -922,6 +936,532 @@ TEST(FrameLock, AFollowerThatMissedCommandsCatchesUpInOrder) {
   EXPECT_EQ(a.commandsRun[250], 7U);
   EXPECT_GE(leader.figures.commandsResent, 8);
   EXPECT_EQ(leader.figures.commandsApplied, 7);
+}
+
+}  // namespace
+}  // namespace basalt::kiosk
+
+namespace basalt::kiosk {
+namespace {
+
+// ---- Authentication and sanity (lock.key_file, max_followers, max_frame_jump) ----
+
+/// A key file readable only by its owner, as `openssl rand -hex 32` writes one.
+std::filesystem::path writeKey(std::string_view name, std::string_view key) {
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("basalt-lock-keys-{}", ::getpid());
+  std::filesystem::create_directories(dir);
+  const auto file = dir / name;
+  std::ofstream(file) << key << "\n";
+  std::filesystem::permissions(file, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  return file;
+}
+
+const std::string kGroupKey = "5f0c2a7e91d84b36a1c9e07d2f6b8a4c3e1d5f7092b4c6e8a0d2f4b6c8e0a2d4";
+const std::string kOtherKey = "0b1e4d7a2c5f8e1b4d7a0c3f6e9b2d5a8c1f4e7b0d3a6c9f2e5b8d1a4c7f0e3b";
+
+LockSpec keyed(LockSpec spec, const std::filesystem::path& key) {
+  spec.keyFile = key;
+  return spec;
+}
+
+/// Drives a leader's frames (each frame's barrier serves handshakes and answers) from `first`:
+/// `limit` of them, or, with no limit, until `done` says so, a frame every 2 ms or so. Returns
+/// the frames drawn. Not a timing assertion: the 60 s only end a test that would hang.
+template <typename Done>
+std::int64_t pumpLeader(FrameLock& leader, runtime::Show& show, Done done, std::int64_t first = 0,
+                        std::int64_t limit = -1) {
+  NullOutput output;
+  const auto giveUp = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  std::int64_t f = first;
+  for (; (limit < 0 ? std::chrono::steady_clock::now() < giveUp && !done() : f < first + limit); ++f) {
+    show.rotateGlobal({1.0f, 0.0f, 0.0f});
+    FrameContext c{f, std::chrono::milliseconds(16) * f, false};
+    EXPECT_TRUE(leader.beforeDraw(c));
+    EXPECT_TRUE(leader.afterDraw(c, output));
+    if (limit < 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return f - first;
+}
+
+// Makes sure a leader and followers holding the same key lock every frame as without one, and
+// say that they are authenticated. Example failure: CURVE set up on one socket only, so that
+// the followers never hear a frame.
+TEST(FrameLockAuth, NodesWithTheSameKeyLockEveryFrame) {
+  const int port = freePortPair();
+  const auto key = writeKey("same.key", kGroupKey);
+  constexpr std::int64_t kFrames = 120;
+  LeaderNode leader;
+  FollowerNode a;
+  FollowerNode b;
+  std::thread ta([&] { a.run(keyed(followerSpec(port, "a"), key)); });
+  std::thread tb([&] { b.run(keyed(followerSpec(port, "b"), key)); });
+  leader.run(keyed(leaderSpec(port, 2, 2000), key), kFrames, std::chrono::microseconds(0));
+  ta.join();
+  tb.join();
+  ASSERT_EQ(leader.failure, "");
+  EXPECT_EQ(leader.joined, 2);
+  EXPECT_TRUE(leader.figures.authenticated);
+  EXPECT_EQ(leader.figures.rejected.total(), 0);
+  for (const FollowerNode* f : {&a, &b}) {
+    ASSERT_EQ(f->failure, "");
+    ASSERT_EQ(f->frames.size(), static_cast<std::size_t>(kFrames));
+    EXPECT_TRUE(contiguous(f->frames));
+    EXPECT_EQ(f->globals, leader.globals);
+    EXPECT_TRUE(f->figures.authenticated);
+    EXPECT_EQ(f->figures.rejected.total(), 0);
+  }
+  EXPECT_EQ(leader.figures.barrierTimeouts, 0);
+}
+
+// Makes sure a follower without the key, and one with another key, are never admitted: the
+// leader counts their handshakes and keeps only the follower with the key, and they draw none
+// of its frames. Example failure: a leader that accepts any CURVE client (no ZAP check), or
+// falls back to no security for a peer that offers none.
+TEST(FrameLockAuth, FollowersWithoutTheKeyOrWithAnotherAreNotAdmitted) {
+  const int port = freePortPair() + 2;
+  const auto key = writeKey("group.key", kGroupKey);
+  const auto other = writeKey("other.key", kOtherKey);
+  SystemClock clock;
+  runtime::Show show;
+  auto leader = FrameLock::create(keyed(leaderSpec(port, 1, 20), key), clock, show);
+  ASSERT_TRUE(leader) << leader.error().message();
+  FollowerNode good;
+  FollowerNode none;
+  FollowerNode wrong;
+  std::thread tn([&] { none.run(followerSpec(port, "none")); });
+  std::thread tw([&] { wrong.run(keyed(followerSpec(port, "wrong"), other)); });
+  std::thread tg([&] { good.run(keyed(followerSpec(port, "good"), key)); });
+  pumpLeader(**leader, show, [&] {
+    const FrameLockFigures f = (*leader)->figures();
+    return f.rejected.noKey + f.rejected.handshake >= 2 && f.rejected.wrongKey >= 2 && good.frames.size() >= 20;
+  });
+  const FrameLockFigures f = (*leader)->figures();
+  none.quit = true;
+  wrong.quit = true;
+  (*leader)->sayBye(0);
+  tn.join();
+  tw.join();
+  tg.join();
+  // A peer without the key is seen offering none (no_key), or hanging up first when it saw
+  // the leader's CURVE greeting (handshake); which one is a race between the two ends.
+  EXPECT_GE(f.rejected.noKey + f.rejected.handshake, 2);
+  EXPECT_GE(f.rejected.wrongKey, 2);
+  EXPECT_GE(none.figures.rejected.noKey + none.figures.rejected.handshake, 1);
+  EXPECT_EQ(f.followersKnown, 1);  // "good" only
+  EXPECT_EQ(f.followers, 1);
+  EXPECT_GE(good.frames.size(), 20U);
+  EXPECT_TRUE(none.frames.empty());
+  EXPECT_TRUE(wrong.frames.empty());
+  EXPECT_FALSE(none.figures.leaderPresent);
+  EXPECT_FALSE(wrong.figures.leaderPresent);
+}
+
+/// A ZeroMQ socket of the test's own, outside any FrameLock: a forger's.
+struct RawZmq {
+  void* context = zmq_ctx_new();
+  void* socket = nullptr;
+  explicit RawZmq(int type) : socket(zmq_socket(context, type)) {
+    const int linger = 0;
+    zmq_setsockopt(socket, ZMQ_LINGER, &linger, sizeof linger);
+  }
+  ~RawZmq() {
+    zmq_close(socket);
+    zmq_ctx_term(context);
+  }
+  RawZmq(const RawZmq&) = delete;
+  RawZmq& operator=(const RawZmq&) = delete;
+  RawZmq(RawZmq&&) = delete;
+  RawZmq& operator=(RawZmq&&) = delete;
+  void send(const LockBuffer& buffer, std::size_t n) const { (void)zmq_send(socket, buffer.data(), n, ZMQ_DONTWAIT); }
+};
+
+// Makes sure a well-formed message from a socket without the key changes nothing on a keyed
+// leader: the forger's "ready" never makes it a follower, and its handshake is counted.
+// Example failure: the leader's answer socket left without CURVE, so that a forged "ready"
+// joins the barrier.
+TEST(FrameLockAuth, AForgedAnswerChangesNothingOnTheLeader) {
+  const int port = freePortPair() + 4;
+  const auto key = writeKey("forged.key", kGroupKey);
+  SystemClock clock;
+  runtime::Show show;
+  auto leader = FrameLock::create(keyed(leaderSpec(port, 0, 20), key), clock, show);
+  ASSERT_TRUE(leader) << leader.error().message();
+  RawZmq forger(ZMQ_DEALER);
+  zmq_setsockopt(forger.socket, ZMQ_ROUTING_ID, "intruder", 8);
+  ASSERT_EQ(zmq_connect(forger.socket, fmt::format("tcp://127.0.0.1:{}", port + 1).c_str()), 0);
+  LockBuffer buffer{};
+  ReadyMessage ready;
+  ready.setNodeName("intruder");
+  std::int64_t sent = 0;
+  pumpLeader(**leader, show, [&] {
+    ready.frame = sent++ % 2 == 0 ? -1 : 0;  // a hello, then "drew frame 0"
+    forger.send(buffer, encode(ready, buffer));
+    const LockRejections r = (*leader)->figures().rejected;
+    return r.noKey + r.handshake >= 1 && sent >= 20;
+  });
+  const FrameLockFigures f = (*leader)->figures();
+  EXPECT_GE(f.rejected.noKey + f.rejected.handshake, 1);  // no_key, or hung up first (a race)
+  EXPECT_EQ(f.followersKnown, 0);
+  EXPECT_EQ(f.followers, 0);
+  EXPECT_EQ(f.malformed, 0);  // nothing of it reached the decoder
+}
+
+// Makes sure a keyed follower takes nothing from a "leader" without the key: well-formed frames
+// published by a plain socket at the leader's address are never drawn, and the handshake is
+// counted. Example failure: the follower's SUB socket left without CURVE.
+TEST(FrameLockAuth, AForgedFrameChangesNothingOnAFollower) {
+  const int port = freePortPair() + 6;
+  const auto key = writeKey("follower.key", kGroupKey);
+  RawZmq fake(ZMQ_PUB);
+  ASSERT_EQ(zmq_bind(fake.socket, fmt::format("tcp://127.0.0.1:{}", port).c_str()), 0);
+  SystemClock clock;
+  auto loop = runtime::EventLoop::create(clock);
+  ASSERT_TRUE(loop);
+  runtime::Show show;
+  auto follower = FrameLock::create(keyed(followerSpec(port, "a"), key), clock, show);
+  ASSERT_TRUE(follower) << follower.error().message();
+  LockBuffer buffer{};
+  FrameMessage frame = sampleFrame();
+  std::int64_t drawn = 0;
+  const auto refused = [&] {
+    const LockRejections r = (*follower)->figures().rejected;
+    return r.noKey + r.handshake;  // no_key, or hung up first (a race between the two ends)
+  };
+  for (int i = 0; i < 2000 && (refused() < 1 || i < 20); ++i) {
+    frame.frame = i;
+    fake.send(buffer, encode(frame, buffer));
+    auto next = (*follower)->nextFrame(**loop, std::chrono::milliseconds(5));
+    ASSERT_TRUE(next);
+    if (*next && !(*next)->end) ++drawn;
+  }
+  const FrameLockFigures f = (*follower)->figures();
+  EXPECT_GE(refused(), 1);
+  EXPECT_EQ(drawn, 0);
+  EXPECT_FALSE(f.leaderPresent);
+  EXPECT_EQ(f.malformed, 0);
+}
+
+/// A TCP relay on loopback that records what the client sent: a wiretap between a follower and
+/// its leader.
+class Wiretap {
+ public:
+  Wiretap(int listenPort, int targetPort) : target_(targetPort) {
+    listener_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    const int on = 1;
+    ::setsockopt(listener_, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+    sockaddr_in at = loopback(listenPort);
+    ok_ = ::bind(listener_, reinterpret_cast<sockaddr*>(&at), sizeof at) == 0 && ::listen(listener_, 4) == 0;
+    thread_ = std::thread([this] { relay(); });
+  }
+  ~Wiretap() {
+    stop_ = true;
+    thread_.join();
+    ::close(listener_);
+  }
+  Wiretap(const Wiretap&) = delete;
+  Wiretap& operator=(const Wiretap&) = delete;
+  Wiretap(Wiretap&&) = delete;
+  Wiretap& operator=(Wiretap&&) = delete;
+  [[nodiscard]] bool ok() const { return ok_; }
+  /// What the first client sent, so far.
+  [[nodiscard]] std::string captured() {
+    const std::lock_guard lock(mutex_);
+    return captured_;
+  }
+  static sockaddr_in loopback(int port) {
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    return a;
+  }
+
+ private:
+  void relay() {
+    int client = -1;
+    int server = -1;
+    std::array<char, 4096> chunk{};
+    while (!stop_) {
+      std::vector<pollfd> fds{{listener_, POLLIN, 0}};
+      if (client >= 0) fds.push_back({client, POLLIN, 0});
+      if (server >= 0) fds.push_back({server, POLLIN, 0});
+      if (::poll(fds.data(), fds.size(), 20) <= 0) continue;
+      if ((fds[0].revents & POLLIN) != 0) {
+        const int s = ::accept(listener_, nullptr, nullptr);
+        if (client >= 0) {
+          ::close(s);  // one follower connection is enough to capture
+        } else {
+          client = s;
+          server = ::socket(AF_INET, SOCK_STREAM, 0);
+          sockaddr_in to = loopback(target_);
+          if (::connect(server, reinterpret_cast<sockaddr*>(&to), sizeof to) != 0) stop_ = true;
+        }
+        continue;
+      }
+      for (std::size_t i = 1; i < fds.size(); ++i) {
+        if ((fds[i].revents & (POLLIN | POLLHUP)) == 0) continue;
+        const ssize_t n = ::read(fds[i].fd, chunk.data(), chunk.size());
+        if (n <= 0) {
+          stop_ = true;
+          break;
+        }
+        const bool fromClient = fds[i].fd == client;
+        if (fromClient) {
+          const std::lock_guard lock(mutex_);
+          captured_.append(chunk.data(), static_cast<std::size_t>(n));
+        }
+        (void)::write(fromClient ? server : client, chunk.data(), static_cast<std::size_t>(n));
+      }
+    }
+    if (client >= 0) ::close(client);
+    if (server >= 0) ::close(server);
+  }
+
+  int target_;
+  int listener_ = -1;
+  bool ok_ = false;
+  std::atomic<bool> stop_{false};
+  std::mutex mutex_;
+  std::string captured_;  // guarded by mutex_
+  std::thread thread_;
+};
+
+// Makes sure a captured conversation of a follower with its leader, sent again on a new
+// connection, admits nobody and is counted: the capture holds a whole CURVE handshake and the
+// follower's answers, and proves nothing a second time. Example failure: authentication by a
+// fixed token or MAC without a nonce, which a replay passes.
+TEST(FrameLockAuth, AReplayedCaptureChangesNothingAndIsCounted) {
+  const int port = freePortPair() + 8;
+  const int tapped = port + 4;  // the follower's answers go through the wiretap
+  const auto key = writeKey("replay.key", kGroupKey);
+  SystemClock clock;
+  runtime::Show show;
+  auto leader = FrameLock::create(keyed(leaderSpec(port, 1, 2000), key), clock, show);
+  ASSERT_TRUE(leader) << leader.error().message();
+  // The follower's spec names the taps' port pair: its frames and answers pass through them,
+  // and the answers' tap keeps what the follower sent.
+  Wiretap frames(tapped, port);
+  Wiretap answers(tapped + 1, port + 1);
+  ASSERT_TRUE(frames.ok());
+  ASSERT_TRUE(answers.ok());
+  FollowerNode a;
+  std::thread ta([&] { a.run(keyed(followerSpec(tapped, "a"), key)); });
+  std::int64_t frame = 0;
+  frame += pumpLeader(**leader, show, [&] { return a.frames.size() >= 10; });
+  const std::string capture = answers.captured();
+  ASSERT_GT(capture.size(), 200U);  // the handshake and at least one answer
+  const FrameLockFigures before = (*leader)->figures();
+  ASSERT_EQ(before.followersKnown, 1);
+
+  // The replay: the captured bytes on a fresh connection to the leader's answer port.
+  const int replay = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in to = Wiretap::loopback(port + 1);
+  ASSERT_EQ(::connect(replay, reinterpret_cast<sockaddr*>(&to), sizeof to), 0);
+  ASSERT_EQ(::write(replay, capture.data(), capture.size()), static_cast<ssize_t>(capture.size()));
+  // ZeroMQ reports the replayed handshake's stale cookie as a protocol error (handshake) or a
+  // cryptographic one (wrong_key), depending on where it notices.
+  const auto refusedHandshakes = [](const FrameLockFigures& f) { return f.rejected.handshake + f.rejected.wrongKey; };
+  frame += pumpLeader(
+      **leader, show, [&] { return refusedHandshakes((*leader)->figures()) > refusedHandshakes(before); }, frame);
+  ::close(replay);
+  a.quit = true;
+  (*leader)->sayBye(frame);
+  ta.join();
+  const FrameLockFigures f = (*leader)->figures();
+  EXPECT_GT(refusedHandshakes(f), refusedHandshakes(before));
+  EXPECT_EQ(f.rejected.noKey, 0);
+  EXPECT_EQ(f.followersKnown, 1);  // the replay joined nobody, not even "a" a second time
+  EXPECT_LE(f.followers, 1);
+  EXPECT_EQ(f.malformed, 0);  // nothing of it reached the decoder
+}
+
+// Makes sure a frame number far past the last is refused, not drawn, and counted once per
+// frame, with the presents for it; the frames after it, within the bound, are drawn on.
+// Example failure: a follower that takes frame 10 000 from a leader at frame 20 and then
+// refuses every real frame as old, frozen.
+TEST(FrameLockSanity, AFrameJumpPastTheBoundIsRefused) {
+  const int port = freePortPair() + 10;
+  SystemClock clock;
+  runtime::Show show;
+  LockSpec leaderAt = leaderSpec(port, 1, 1000);
+  leaderAt.dropAfter = 100;  // the follower stays in the barrier through the refused frames
+  auto leader = FrameLock::create(leaderAt, clock, show);
+  ASSERT_TRUE(leader) << leader.error().message();
+  LockSpec spec = followerSpec(port, "a", 20000);
+  spec.maxFrameJump = 50;
+  FollowerNode a;
+  std::thread ta([&] { a.run(spec); });
+  auto loop = runtime::EventLoop::create(clock);
+  ASSERT_TRUE(loop);
+  ASSERT_EQ((*leader)->awaitFollowers(**loop), 1);
+  EXPECT_EQ(pumpLeader(**leader, show, [] { return false; }, 0, 20), 20);   // frames 0..19
+  EXPECT_EQ(pumpLeader(**leader, show, [] { return false; }, 100, 5), 5);   // 100..104: 81 past 19
+  EXPECT_EQ(pumpLeader(**leader, show, [] { return false; }, 20, 20), 20);  // 20..39
+  (*leader)->sayBye(39);
+  ta.join();
+  ASSERT_EQ(a.failure, "");
+  std::vector<std::int64_t> expected(40);
+  for (std::int64_t i = 0; i < 40; ++i) expected[static_cast<std::size_t>(i)] = i;
+  EXPECT_EQ(a.frames, expected);
+  EXPECT_EQ(a.figures.rejected.frameJump, 5);
+  EXPECT_EQ(a.figures.rejected.outOfSequence, 5);  // "present 100".."present 104"
+  EXPECT_EQ(a.figures.leaderLost, 0);
+}
+
+// Makes sure a leader admits at most max_followers: the extra follower is refused and counted,
+// and the barrier holds only the admitted one. Example failure: a leader whose barrier any
+// number of names can fill, so that followers without end stretch every frame.
+TEST(FrameLockSanity, FollowersBeyondTheLimitAreRefused) {
+  const int port = freePortPair() + 12;
+  SystemClock clock;
+  runtime::Show show;
+  LockSpec spec = leaderSpec(port, 1, 20);
+  spec.maxFollowers = 1;
+  auto leader = FrameLock::create(spec, clock, show);
+  ASSERT_TRUE(leader) << leader.error().message();
+  FollowerNode a;
+  FollowerNode b;
+  std::thread ta([&] { a.run(followerSpec(port, "a")); });
+  std::thread tb([&] { b.run(followerSpec(port, "b")); });
+  const std::int64_t drawn = pumpLeader(**leader, show, [&] {
+    const FrameLockFigures f = (*leader)->figures();
+    return f.followersKnown == 1 && f.rejected.followersFull >= 3;
+  });
+  (*leader)->sayBye(drawn);
+  ta.join();
+  tb.join();
+  const FrameLockFigures f = (*leader)->figures();
+  EXPECT_EQ(f.followersKnown, 1);
+  EXPECT_EQ(f.followers, 1);
+  EXPECT_GE(f.rejected.followersFull, 3);
+}
+
+/// An IPv4 address of this machine other than loopback, if it has one.
+std::optional<in_addr> outsideAddress() {
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) != 0) return std::nullopt;
+  std::optional<in_addr> found;
+  for (const ifaddrs* i = list; i && !found; i = i->ifa_next) {
+    if (!i->ifa_addr || i->ifa_addr->sa_family != AF_INET) continue;
+    const in_addr a = reinterpret_cast<const sockaddr_in*>(i->ifa_addr)->sin_addr;
+    if ((ntohl(a.s_addr) >> 24) != 127) found = a;
+  }
+  ::freeifaddrs(list);
+  return found;
+}
+
+// Makes sure a leader listens on loopback unless the manifest names another address: its ports
+// answer on 127.0.0.1 and refuse this machine's other addresses. Example failure: the old
+// default of 0.0.0.0, which opens the lock to every network the node is on.
+TEST(FrameLockSanity, TheDefaultBindIsLoopback) {
+  EXPECT_EQ(LockSpec{}.listen, "127.0.0.1");
+  auto manifest = readLockManifest("[lock]\nrole = \"leader\"\n");
+  ASSERT_TRUE(manifest.manifest) << manifest.diagnostics.format();
+  EXPECT_EQ(manifest.manifest->lock.listen, "127.0.0.1");
+
+  const int port = freePortPair() + 14;
+  LockSpec spec = manifest.manifest->lock;
+  spec.node = "leader";
+  spec.port = port;
+  SystemClock clock;
+  runtime::Show show;
+  auto leader = FrameLock::create(spec, clock, show);
+  ASSERT_TRUE(leader) << leader.error().message();
+  const auto connects = [](in_addr address, int p) {
+    const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(static_cast<std::uint16_t>(p));
+    to.sin_addr = address;
+    const bool ok = ::connect(s, reinterpret_cast<sockaddr*>(&to), sizeof to) == 0;
+    ::close(s);
+    return ok;
+  };
+  in_addr loopback{};
+  loopback.s_addr = htonl(INADDR_LOOPBACK);
+  EXPECT_TRUE(connects(loopback, port));
+  EXPECT_TRUE(connects(loopback, port + 1));
+  const std::optional<in_addr> outside = outsideAddress();
+  if (!outside) GTEST_SKIP() << "this machine has no IPv4 address besides loopback to try";
+  EXPECT_FALSE(connects(*outside, port));
+  EXPECT_FALSE(connects(*outside, port + 1));
+}
+
+// Makes sure the new [lock] keys are read, their mistakes named with their line and the nearest
+// key, and a lock off loopback without a key warned about. Example failure: a misspelt key_file
+// silently ignored, leaving the lock unauthenticated.
+TEST(LockManifest, KeyFileLimitsAndListenAreChecked) {
+  const auto key = writeKey("manifest.key", kGroupKey);
+  auto good =
+      readLockManifest(fmt::format("[lock]\nrole = \"leader\"\nlisten = \"10.0.0.10\"\nkey_file = \"{}\"\n"
+                                   "max_followers = 4\nmax_frame_jump = 120\nfollowers = 3\n",
+                                   key.string()));
+  ASSERT_TRUE(good.manifest) << good.diagnostics.format();
+  EXPECT_EQ(good.manifest->lock.keyFile, key);
+  EXPECT_EQ(good.manifest->lock.maxFollowers, 4);
+  EXPECT_EQ(good.manifest->lock.maxFrameJump, 120);
+  EXPECT_EQ(good.manifest->lock.listen, "10.0.0.10");
+  EXPECT_FALSE(mentions(good, 3, "unauthenticated")) << good.diagnostics.format();
+
+  auto typo = readLockManifest("[lock]\nrole = \"leader\"\nkey_fil = \"lock.key\"\n");
+  EXPECT_FALSE(typo.manifest);
+  EXPECT_TRUE(mentions(typo, 3, "key_file")) << typo.diagnostics.format();
+
+  auto open = readLockManifest("[lock]\nrole = \"leader\"\nlisten = \"0.0.0.0\"\n");
+  ASSERT_TRUE(open.manifest) << open.diagnostics.format();
+  EXPECT_TRUE(mentions(open, 3, "unauthenticated")) << open.diagnostics.format();
+  auto remote = readLockManifest("[lock]\nrole = \"follower\"\nleader = \"10.0.0.10\"\n");
+  ASSERT_TRUE(remote.manifest);
+  EXPECT_TRUE(mentions(remote, 1, "unauthenticated")) << remote.diagnostics.format();
+  auto local = readLockManifest("[lock]\nrole = \"follower\"\nleader = \"127.0.0.1\"\n");
+  ASSERT_TRUE(local.manifest);
+  EXPECT_FALSE(mentions(local, 1, "unauthenticated")) << local.diagnostics.format();
+
+  auto name = readLockManifest("[lock]\nrole = \"leader\"\nlisten = \"eth0\"\n");
+  EXPECT_FALSE(name.manifest);
+  EXPECT_TRUE(mentions(name, 3, "not an IP address")) << name.diagnostics.format();
+
+  auto tooMany = readLockManifest("[lock]\nrole = \"leader\"\nfollowers = 5\nmax_followers = 2\n");
+  EXPECT_FALSE(tooMany.manifest);
+  EXPECT_TRUE(mentions(tooMany, 3, "max_followers")) << tooMany.diagnostics.format();
+
+  const auto shortKey = writeKey("short.key", "abc123");
+  auto weak = readLockManifest(fmt::format("[lock]\nrole = \"leader\"\nkey_file = \"{}\"\n", shortKey.string()));
+  EXPECT_FALSE(weak.manifest);
+  EXPECT_TRUE(mentions(weak, 3, "fewer than 32")) << weak.diagnostics.format();
+
+  const auto shared = writeKey("shared.key", kGroupKey);
+  std::filesystem::permissions(shared, std::filesystem::perms::others_read, std::filesystem::perm_options::add);
+  auto readable = readLockManifest(fmt::format("[lock]\nrole = \"leader\"\nkey_file = \"{}\"\n", shared.string()));
+  ASSERT_TRUE(readable.manifest);
+  EXPECT_TRUE(mentions(readable, 3, "readable by other users")) << readable.diagnostics.format();
+}
+
+// Makes sure the refusals reach /health and /metrics by reason. Example failure: a counter the
+// status page never shows, so that an operator cannot see a peer without the key.
+TEST(FrameLockStatus, RefusalsReachHealthAndMetrics) {
+  StatusSnapshot s;
+  FrameLockFigures leader;
+  leader.leader = true;
+  leader.node = "hub";
+  leader.authenticated = true;
+  leader.rejected.noKey = 3;
+  leader.rejected.wrongKey = 2;
+  leader.rejected.followersFull = 1;
+  s.lock = leader;
+  const auto health = nlohmann::json::parse(healthJson(s));
+  EXPECT_EQ(health["lock"]["authenticated"], true) << health;
+  EXPECT_EQ(health["lock"]["rejected"]["no_key"], 3) << health;
+  EXPECT_EQ(health["lock"]["rejected"]["wrong_key"], 2) << health;
+  EXPECT_EQ(health["lock"]["rejected"]["followers_full"], 1) << health;
+  EXPECT_EQ(health["lock"]["rejected"]["frame_jump"], 0) << health;
+  const std::string metrics = metricsText(s, ServerCounters{});
+  EXPECT_NE(metrics.find("basalt_lock_messages_rejected_total{node=\"hub\",role=\"leader\",reason=\"no_key\"} 3"),
+            std::string::npos)
+      << metrics;
+  EXPECT_NE(metrics.find("basalt_lock_messages_rejected_total{node=\"hub\",role=\"leader\",reason=\"wrong_key\"} 2"),
+            std::string::npos);
+  EXPECT_NE(metrics.find("basalt_lock_authenticated{node=\"hub\",role=\"leader\"} 1"), std::string::npos);
 }
 
 }  // namespace
