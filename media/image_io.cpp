@@ -17,6 +17,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <system_error>
 #include <vector>
@@ -235,6 +236,25 @@ Result<std::vector<std::uint8_t>> encodePng(const Image& image) {
   return bytes;
 }
 
+namespace {
+
+/// `image` with its alpha channel (the last of 2 or 4) removed; 1 and 3 channels unchanged.
+Image withoutAlpha(const Image& image) {
+  if (image.channels != 2 && image.channels != 4) return image;
+  Image out = image;
+  out.channels = image.channels - 1;
+  const std::size_t sample = channelBytes(image.type);
+  const std::size_t pixels = std::size_t{image.width} * image.height;
+  out.pixels.resize(pixels * out.channels * sample);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    std::memcpy(out.pixels.data() + i * out.channels * sample, image.pixels.data() + i * image.channels * sample,
+                out.channels * sample);
+  }
+  return out;
+}
+
+}  // namespace
+
 Result<void> writeImage(const std::filesystem::path& path, const Image& image) {
   if (image.empty() || image.channels < 1 || image.channels > 4 || image.pixels.size() < image.byteSize()) {
     return fail(Errc::kInvalidArgument, "the image to write is empty or malformed", path.string());
@@ -245,6 +265,13 @@ Result<void> writeImage(const std::filesystem::path& path, const Image& image) {
   }
   if (const int depth = sunRasterDepthFor(ext, image.channels); depth != 0) {
     auto bytes = encodeSunRaster(image, depth);
+    if (!bytes) return std::unexpected(bytes.error().at(path.string()));
+    return writeAtomically(path, [&](const std::filesystem::path& tmp) { return writeBytes(tmp, *bytes); });
+  }
+  if (ext == ".ppm" || ext == ".pgm" || ext == ".pnm") {
+    // PPM and PGM hold no alpha: a frame from the screen is opaque, so its alpha is dropped
+    // (.pam keeps it). A grey image in a .ppm is written as PGM, which every PNM reader takes.
+    auto bytes = encodeNetpbm(withoutAlpha(image), false);
     if (!bytes) return std::unexpected(bytes.error().at(path.string()));
     return writeAtomically(path, [&](const std::filesystem::path& tmp) { return writeBytes(tmp, *bytes); });
   }

@@ -12,8 +12,9 @@
 
 namespace basalt::media {
 
-/// \brief Writes `image` to `path`, in the format its extension names (.png, .jpg, .tif, .exr,
-/// .ppm, ... whatever this OpenImageIO writes). The file is written to a temporary name in the
+/// \brief Writes `image` to `path`, in the format its extension names: .png, Netpbm (.ppm, .pgm
+/// and .pnm without alpha, .pam with it) and Sun rasters by Basalt's own codecs; .jpg, .tif,
+/// .exr, ... whatever this OpenImageIO writes. The file is written to a temporary name in the
 /// same folder and renamed, so a reader never sees half a file.
 [[nodiscard]] Result<void> writeImage(const std::filesystem::path& path, const Image& image);
 

@@ -57,6 +57,36 @@ TEST(ImageIo, OtherFormatsGoThroughOpenImageIoByExtension) {
   EXPECT_EQ(magic[1], 0xD8) << "a .jpg snapshot must be written as JPEG";
 }
 
+// A snapshot is RGBA, and PPM has no alpha (Netpbm's ppm(5): "P6", width, height, maxval, then
+// each pixel's red, green and blue): `--snapshot x.ppm` writes the colours and drops the alpha.
+TEST(ImageIo, PpmSnapshotsDropTheAlpha) {
+  const auto dir = test::scratchDir("image-io-ppm");
+  const Image rgba = gradient(5, 3, 4);
+  ASSERT_TRUE(writeImage(dir / "snap.ppm", rgba));
+  std::ifstream in(dir / "snap.ppm", std::ios::binary | std::ios::ate);
+  std::string bytes(static_cast<std::size_t>(in.tellg()), '\0');
+  in.seekg(0);
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  const std::string header = "P6\n5 3\n255\n";
+  ASSERT_TRUE(bytes.starts_with(header)) << bytes.substr(0, 16);
+  ASSERT_EQ(bytes.size(), header.size() + 5 * 3 * 3);
+  for (std::uint32_t y = 0; y < 3; ++y) {
+    for (std::uint32_t x = 0; x < 5; ++x) {
+      for (std::uint32_t c = 0; c < 3; ++c) {
+        EXPECT_EQ(static_cast<std::uint8_t>(bytes[header.size() + (y * 5 + x) * 3 + c]), rgba.at(x, y, c))
+            << x << "," << y << " channel " << c;
+      }
+    }
+  }
+  // Grey with alpha in a .pgm: P5 and the grey samples.
+  const Image greyAlpha = gradient(4, 2, 2);
+  ASSERT_TRUE(writeImage(dir / "snap.pgm", greyAlpha));
+  auto grey = readImage(dir / "snap.pgm");
+  ASSERT_TRUE(grey) << grey.error().describe();
+  EXPECT_EQ(grey->channels, 1u);
+  EXPECT_EQ(grey->at(3, 1, 0), greyAlpha.at(3, 1, 0));
+}
+
 TEST(ImageIo, NoPartialFileIsLeftBehind) {
   const auto dir = test::scratchDir("image-io-partial");
   ASSERT_TRUE(writeImage(dir / "a.png", gradient(8, 8, 4)));
