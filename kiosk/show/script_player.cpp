@@ -76,7 +76,7 @@ void printScriptSummary(const ScriptPlayer& player) {
   const std::size_t parseErrors = in.program().errorCount();
   const std::uint64_t problems = in.runtimeProblems() + parseErrors;
   std::string state = in.quit() ? "quit" : (in.finished() ? "ended" : "still running when the run stopped");
-  fmt::print("basalt: script {}: {} draws, {} commands carried out; {}\n", in.program().file, in.draws(),
+  fmt::print("basalt: script {}: {} draws, {} commands carried out; {}\n", in.program().file, player.drawsShown(),
              in.instructionsRun(),
              problems == 0 ? std::string("no problems") : fmt::format("{} problems reported above", problems));
   fmt::print("basalt: script {}\n", state);
@@ -164,6 +164,7 @@ Result<void> ScriptPlayer::afterDraw(const FrameContext& frame, render::Output& 
   (void)frame;
   frameRead_ = false;
   jitterReady_ = false;
+  if (step_.stop == StepStop::kDraw) ++drawsShown_;
   if (interpreter_.finished()) {
     step_ = {};
     return {};

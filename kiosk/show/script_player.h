@@ -85,6 +85,9 @@ class ScriptPlayer final : public FrameParticipant, public script::Host, public 
   [[nodiscard]] bool renders(script::Feature feature) const override;
 
   [[nodiscard]] const script::Interpreter& interpreter() const { return interpreter_; }
+  /// \brief Frames that showed a draw of the script (the interpreter has also counted the draw it
+  /// stopped at for the next frame, which a run that ends now never shows).
+  [[nodiscard]] std::uint64_t drawsShown() const { return drawsShown_; }
   /// \brief Files save_image wrote, in order.
   [[nodiscard]] const std::vector<std::filesystem::path>& imagesWritten() const { return written_; }
   /// \brief How the frame being made is drawn: the step that ended it.
@@ -121,6 +124,7 @@ class ScriptPlayer final : public FrameParticipant, public script::Host, public 
   bool jitterReady_ = false;                         // jitterAverage_ is the current picture (until the next draw)
   std::unique_ptr<render::PictureOverlay> overlay_;  // puts the jitter average on the output
   std::vector<std::filesystem::path> written_;
+  std::uint64_t drawsShown_ = 0;
   // The VCR (LAVA §7): one movie player and the live camera, shown as kScriptVideoTexture.
   std::unique_ptr<media::MoviePlayer> vcr_;
   bool vcrLoaded_ = false;  // a movie is loaded (the player's state lags its commands)

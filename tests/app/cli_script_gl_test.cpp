@@ -53,7 +53,22 @@ TEST(ScriptCli, RunPlaysAScriptUntilQuit) {
   EXPECT_NE(r.output.find("3 frames"), std::string::npos) << "quit ends the run on the last draw:\n" << r.output;
   EXPECT_NE(r.output.find("manual clock"), std::string::npos) << "a script that quits runs as fast as it can";
   EXPECT_NE(r.output.find("script quit"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(": 3 draws,"), std::string::npos) << "three draws, three frames:\n" << r.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "out/snapshot.png"));
+}
+
+// Each draw ends one frame (LAVA manual §10, draw: "Draw the object once."), so a run stopped
+// after 30 frames reports 30 draws, not the one the script reached for a 31st frame never drawn.
+TEST(ScriptCli, TheDrawCountIsTheFramesDrawn) {
+  std::string why;
+  if (!eglAvailable(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  const auto dir = test::scratchDir("script-cli-draws");
+  const auto script = write(dir, "spin.mdl", "loop 1000\n  position.global_y_rotate = 1\n  draw\nend_loop\n");
+  const auto r =
+      basalt({"run", script.string(), "--headless", "--frames", "30", "--output-dir", (dir / "out").string()});
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("30 frames"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(": 30 draws,"), std::string::npos) << r.output;
 }
 
 TEST(ScriptCli, BadLinesAreReportedAndTheShowGoesOn) {
