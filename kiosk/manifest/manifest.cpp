@@ -792,7 +792,13 @@ class Reader {
       names += v.name;
       ++i;
     }
-    error(lineOf(*node), fmt::format("{}: '{}' is not one of {}", key(path, name), *text, names));
+    std::string_view best;
+    std::size_t bestDistance = 3;
+    for (const auto& v : values) {
+      if (const std::size_t d = editDistance(*text, v.name); d < bestDistance) bestDistance = d, best = v.name;
+    }
+    error(lineOf(*node), fmt::format("{}: '{}' is not one of {}{}", key(path, name), *text, names,
+                                     best.empty() ? std::string() : fmt::format("; did you mean '{}'?", best)));
     return std::nullopt;
   }
 
