@@ -996,9 +996,9 @@ class Reader {
       }
       ViewSpec v;
       v.line = lineOf(*t);
-      checkKeys(
-          *t, path,
-          {"name", "kind", "cave", "facet", "eye", "viewport", "stereo", "eye_spacing", "projection", "of", "from"});
+      checkKeys(*t, path,
+                {"name", "kind", "cave", "facet", "eye", "viewport", "stereo", "eye_spacing", "projection", "winding",
+                 "of", "from"});
       v.name = string(*t, "name", path).value_or(fmt::format("view {}", index));
       if (!names.insert(v.name).second)
         error(v.line, fmt::format("{}: a view named '{}' already exists", path, v.name));
@@ -1036,6 +1036,15 @@ class Reader {
       if (auto spacing = number(*t, "eye_spacing", path, 0.0, 10.0)) v.eyeSpacing = static_cast<float>(*spacing);
       if (auto projection = choice<bool>(*t, "projection", path, {{"rear", true}, {"front", false}})) {
         v.rearProjection = *projection;
+      }
+      if (auto winding = choice<formats::FacetWinding>(*t, "winding", path,
+                                                       {{"inward", formats::FacetWinding::kInward},
+                                                        {"outward", formats::FacetWinding::kOutward},
+                                                        {"auto", formats::FacetWinding::kAuto}})) {
+        v.winding = *winding;
+      }
+      if (v.kind != ViewKind::kFacet && t->get("winding")) {
+        warning(v.line, fmt::format("{}: winding applies to facet views only", path));
       }
       if (auto eye = choice<Eye>(*t, "eye", path, {{"left", Eye::kLeft}, {"right", Eye::kRight}})) v.eye = *eye;
       if (const toml::node* vp = t->get("viewport")) readViewport(*vp, path, v);
