@@ -57,6 +57,11 @@ Result<std::unique_ptr<DisplayViews>> DisplayViews::create(const std::vector<Vie
       }
       v.cave = std::move(*cave);
       d->readSavedCalibration(v);
+      // After the saved calibration, which may name the geometry again.
+      if (s.winding != formats::FacetWinding::kInward) {
+        v.cave.geometry =
+            std::make_shared<const formats::CaveGeometry>(formats::windFacets(*v.cave.geometry, s.winding));
+      }
       if (s.eyeSpacing) v.eyeSpacing = *s.eyeSpacing;
       if (!currentSet) d->current_ = d->views_.size(), currentSet = true;
     }

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "kiosk/loop/display_views.h"
+#include "runtime/image.h"
 #include "support/polyhedra.h"
 #include "support/render_fixture.h"
 #include "support/test_paths.h"
@@ -336,6 +337,36 @@ TEST(DisplayViewsManifest, AidsViewKeysAreReadAndChecked) {
   EXPECT_FALSE(
       kiosk::readManifestText(facet + "[[views]]\nkind = \"aids\"\nfrom = [0, 0, 0]\n", folder / "show.toml", zero));
   EXPECT_NE(zero.format().find("from: must be a direction"), std::string::npos) << zero.format();
+}
+
+// ---- Display geometry wound outward ------------------------------------------------------------
+
+// Makes sure a display geometry wound outward (each facet's corners reversed, as modelling tools
+// export it) draws, with winding = "outward", the same six facet views as the same display wound
+// inward, and that "auto" does too. Example failures: turned facets whose base side moved (each
+// wall turned a quarter); the aids or the projection still using the outward facets (black views).
+TEST_F(DisplayViewsTest, AnOutwardDisplayTurnedDrawsWhatTheInwardOneDraws) {
+  std::ofstream(folder_ / "outward.obj") << reverseFacetWinding(cubeDisplayObj());
+  std::ofstream(folder_ / "outward.cave") << "model outward.obj\nfacet[5]\n";
+  runtime::Show show = runtime::Show::makeDefault();
+  show.global().background = {0.3f, 0.4f, 0.5f};
+  auto inward = kiosk::DisplayViews::create(sixFacets(), renderer(), output().size());
+  ASSERT_TRUE(inward) << inward.error().describe();
+  const Image expected = draw(**inward, show);
+  for (const formats::FacetWinding winding : {formats::FacetWinding::kOutward, formats::FacetWinding::kAuto}) {
+    std::vector<kiosk::ViewSpec> specs = sixFacets();
+    for (kiosk::ViewSpec& s : specs) s.cave = folder_ / "outward.cave", s.winding = winding;
+    auto turned = kiosk::DisplayViews::create(specs, renderer(), output().size());
+    ASSERT_TRUE(turned) << turned.error().describe();
+    const Image actual = draw(**turned, show);
+    const ImageDifference diff = compareImages(expected, actual, 2);
+    EXPECT_TRUE(diff.sameShape);
+    EXPECT_EQ(diff.pixelsOverTolerance, 0u) << "largest difference " << diff.maxChannelDelta;
+  }
+  // The inward picture is not black (else the comparison would prove nothing).
+  std::size_t lit = 0;
+  for (std::size_t i = 0; i < expected.pixels.size(); ++i) lit += expected.pixels[i] > 16 ? 1U : 0U;
+  EXPECT_GT(lit, expected.pixels.size() / 4);
 }
 
 }  // namespace
