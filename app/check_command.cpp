@@ -108,7 +108,8 @@ Finds every error in the files of a show without running anything, and prints ea
   .obj    Wavefront OBJ model (plain or Extended), with its material libraries
   .off    OFF model
   .cave   cave file: its settings, and the cave geometry model it names (facets flat,
-          convex, the facet and side it names present)
+          convex, the facet and side it names present, facing the viewer: a geometry
+          wound outward is said once, with its lines and the fix)
 
 Each file ends with one line that counts the errors and warnings printed above it.
 

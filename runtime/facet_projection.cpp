@@ -23,7 +23,7 @@ Result<void> computeFacetView(const formats::CaveFacet& facet, const FacetViewIn
   out.forward = -normal;
   out.collision = input.viewer - normal * distance;
   out.baseSide = static_cast<std::uint32_t>((facet.longestSide + input.calibration.side) % n);
-  if (!(distance > 1e-6f)) {
+  if (!(distance > formats::kCaveViewerClearance)) {
     out.visible = false;
     out.border.clear();
     return {};

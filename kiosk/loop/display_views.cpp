@@ -57,6 +57,11 @@ Result<std::unique_ptr<DisplayViews>> DisplayViews::create(const std::vector<Vie
       }
       v.cave = std::move(*cave);
       d->readSavedCalibration(v);
+      // After the saved calibration, which may name the geometry again.
+      if (s.winding != formats::FacetWinding::kInward) {
+        v.cave.geometry =
+            std::make_shared<const formats::CaveGeometry>(formats::windFacets(*v.cave.geometry, s.winding));
+      }
       if (s.eyeSpacing) v.eyeSpacing = *s.eyeSpacing;
       if (!currentSet) d->current_ = d->views_.size(), currentSet = true;
     }
@@ -199,17 +204,49 @@ void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
           case S::kTopBottom: pass.stereo = true, pass.stereoMode = runtime::StereoMode::kTopBottom; break;
         }
         pass.eyeSpacing = v.eyeSpacing >= 0 ? v.eyeSpacing : show.stereo().eyeSpacing;
-        if (auto r = facets_->draw(renderer_, show, pass, adjust); !r && !v.warned) {
-          log::error(kLogViews, "view '{}': facet {} of {}: {}", v.spec.name, index, v.spec.cave.string(),
-                     r.error().message());
-          v.warned = true;
-        }
+        const auto r = facets_->draw(renderer_, show, pass, adjust);
         v.last = facets_->lastProjection();
+        const bool empty = !r || !v.last.visible;
+        if (empty != v.empty) noteEmpty(v, index, empty, r ? nullptr : &r.error());
         break;
       }
       case ViewKind::kAids: drawAids(v, show, adjust); break;
     }
   }
+}
+
+void DisplayViews::noteEmpty(View& v, std::uint32_t index, bool empty, const Error* error) {
+  v.empty = empty;
+  if (!empty) {
+    v.emptyWhy.clear();
+    log::info(kLogViews, "view '{}' draws again (facet {})", v.spec.name, index);
+  } else {
+    const formats::CaveFacet& f = v.cave.geometry->facets[index];
+    const std::string facet =
+        fmt::format("facet {} of {} (line {})", index, v.cave.geometry->path.filename().string(), f.line);
+    if (error) {
+      v.emptyWhy = fmt::format("{}: {}", facet, error->message());
+    } else if (!f.facesInward) {
+      // Thesis §4.2.1 and §4.4.1: the facet's front faces away from the viewer, so it is culled.
+      v.emptyWhy = fmt::format(
+          "{} faces away from the viewer: the display geometry is wound outward (its corners "
+          "run clockwise seen from inside); set winding = \"outward\" (or \"auto\") in this "
+          "view's [[views]] entry, or reverse the corners of the geometry's facets "
+          "('basalt check' names them)",
+          facet);
+    } else {
+      v.emptyWhy = fmt::format(
+          "the viewer, at the display geometry's origin, is behind or on the plane of {}: the "
+          "origin is outside the display; model the display around its origin",
+          facet);
+    }
+    log::warn(kLogViews, "view '{}' draws nothing (reported once): {}", v.spec.name, v.emptyWhy);
+  }
+  problems_.clear();
+  for (const View& w : views_) {
+    if (w.empty) problems_.push_back(fmt::format("view '{}' draws nothing: {}", w.spec.name, w.emptyWhy));
+  }
+  ++problemsVersion_;
 }
 
 bool DisplayViews::selectView(std::size_t index) {

@@ -10,6 +10,7 @@
 /// saved back to its `.cave` file, or, where the show's folder is not the node's to write (a
 /// service), to a cave file of its own in a folder of saved calibrations, read back at start.
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -81,6 +82,12 @@ class DisplayViews final : public ViewDrawer {
   /// \brief The visual aids drawn last by view `index` (aids views).
   [[nodiscard]] const runtime::CaveAids* aids(std::size_t index) const;
   [[nodiscard]] std::size_t size() const { return views_.size(); }
+  /// \brief The views that draw nothing (a facet view whose facet the viewer sees from behind,
+  /// thesis §4.4.1: wound outward, or the viewer outside the display), one line each saying why
+  /// and what to do. Logged once when a view empties (and when it draws again), not per frame.
+  [[nodiscard]] const std::vector<std::string>& problems() const { return problems_; }
+  /// \brief Changes each time problems() does, so that a reader copies them only then.
+  [[nodiscard]] std::uint64_t problemsVersion() const { return problemsVersion_; }
 
  private:
   struct View {
@@ -88,8 +95,9 @@ class DisplayViews final : public ViewDrawer {
     render::Viewport viewport;  ///< GL coordinates (from the bottom left)
     formats::LoadedCave cave;   ///< facet views
     runtime::FacetProjection last;
-    float eyeSpacing = -1;  ///< facet views: < 0 follows the show
-    bool warned = false;
+    float eyeSpacing = -1;                  ///< facet views: < 0 follows the show
+    bool empty = false;                     ///< facet views: the last frame drew nothing (see problems())
+    std::string emptyWhy;                   ///< facet views: why, while empty
     std::size_t shows = 0;                  ///< aids views: the facet view whose set-up they show
     std::optional<runtime::CaveAids> aids;  ///< aids views
   };
@@ -98,6 +106,9 @@ class DisplayViews final : public ViewDrawer {
   /// The facet input of facet view `v` this frame (no aspect: the caller sets it).
   static runtime::FacetViewInput facetInput(const View& v, const runtime::Show& show);
   void drawAids(View& v, const runtime::Show& show, const std::function<void(runtime::ViewTransforms&)>& adjust);
+  /// Notes that facet view `v` (showing facet `index`) drew nothing or something again: logged,
+  /// and problems() rebuilt, only when that changes. `error` is the draw's error, if any.
+  void noteEmpty(View& v, std::uint32_t index, bool empty, const Error* error);
   /// Starts facet view `v` from its saved calibration when there is one newer than its cave file.
   void readSavedCalibration(View& v) const;
   DisplayViews(render::Renderer& renderer, std::unique_ptr<render::FacetRenderer> facets,
@@ -110,6 +121,8 @@ class DisplayViews final : public ViewDrawer {
   std::vector<View> views_;
   std::size_t current_ = 0;
   runtime::CaveKeys keys_;
+  std::vector<std::string> problems_;
+  std::uint64_t problemsVersion_ = 0;
 };
 
 }  // namespace basalt::kiosk

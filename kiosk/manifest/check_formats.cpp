@@ -89,7 +89,9 @@ Findings findScene(const std::filesystem::path& file) {
   return f;
 }
 
-Findings findCave(const std::filesystem::path& file) {
+/// `facing`: also whether the facets face the viewer as written (a whole cave file). A manifest
+/// asks that per facet view, knowing the view's `winding` (checkCaveFacing).
+Findings findCave(const std::filesystem::path& file, bool facing) {
   Findings f;
   auto cave = formats::loadCave(file, nullptr, quietOptions());
   if (!cave) {
@@ -97,6 +99,11 @@ Findings findCave(const std::filesystem::path& file) {
     return f;
   }
   addWarnings(f, cave->warnings, file);
+  if (facing && cave->geometry) {
+    if (auto problem = formats::caveFacingProblem(*cave->geometry, formats::FacetWinding::kInward)) {
+      addWarnings(f, {*problem}, file);
+    }
+  }
   f.items = cave->geometry ? cave->geometry->facets.size() : 0;
   return f;
 }
@@ -112,10 +119,23 @@ CheckResult result(Findings f) {
 
 CheckResult checkSceneFile(const std::filesystem::path& file) { return result(findScene(file)); }
 CheckResult checkModelFile(const std::filesystem::path& file) { return result(findModel(file)); }
-CheckResult checkCaveFile(const std::filesystem::path& file) { return result(findCave(file)); }
+CheckResult checkCaveFile(const std::filesystem::path& file) { return result(findCave(file, true)); }
 
 std::vector<Diagnostic> checkSceneContent(const std::filesystem::path& file) { return findScene(file).problems; }
 std::vector<Diagnostic> checkModelContent(const std::filesystem::path& file) { return findModel(file).problems; }
-std::vector<Diagnostic> checkCaveContent(const std::filesystem::path& file) { return findCave(file).problems; }
+std::vector<Diagnostic> checkCaveContent(const std::filesystem::path& file) { return findCave(file, false).problems; }
+
+std::vector<Diagnostic> checkCaveFacing(const std::filesystem::path& cave, formats::FacetWinding winding,
+                                        std::string_view view) {
+  auto loaded = formats::loadCave(cave, nullptr, quietOptions());
+  // A cave that does not load is reported by its content check.
+  if (!loaded || !loaded->geometry) return {};
+  auto problem = formats::caveFacingProblem(*loaded->geometry, winding);
+  if (!problem) return {};
+  problem->message = fmt::format("facet view '{}': {}", view, problem->message);
+  Findings f;
+  addWarnings(f, {*problem}, cave);
+  return f.problems;
+}
 
 }  // namespace basalt::kiosk

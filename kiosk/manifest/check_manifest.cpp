@@ -1,9 +1,13 @@
 // `basalt check show.toml`: the manifest checker. Reads the manifest as `basalt run` does, with
 // every referenced file's own checker, and returns all problems and its verdict on the show.
 
+#include <set>
+#include <utility>
+
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "kiosk/manifest/check_formats.h"
 #include "kiosk/manifest/content_check.h"
 #include "kiosk/manifest/manifest.h"
 
@@ -17,6 +21,15 @@ CheckResult checkManifestFile(const std::filesystem::path& file) {
   CheckResult result;
   result.diagnostics = diagnostics.items();
   result.items = 1;
+  if (manifest) {
+    // Whether each facet view sees its facets' fronts: said once per cave file and winding, for
+    // the first view that shows it that way.
+    std::set<std::pair<std::filesystem::path, formats::FacetWinding>> facing;
+    for (const ViewSpec& v : manifest->views) {
+      if (v.kind != ViewKind::kFacet || v.cave.empty() || !facing.emplace(v.cave, v.winding).second) continue;
+      for (Diagnostic& d : checkCaveFacing(v.cave, v.winding, v.name)) result.diagnostics.push_back(std::move(d));
+    }
+  }
   if (!manifest && result.errors() == 0) {
     // Not expected (the reader says why it gives up), but a manifest that is not read is never "ok".
     result.diagnostics.push_back({Severity::kError, file, 0, "the manifest could not be read"});

@@ -826,7 +826,13 @@ class Reader {
       names += v.name;
       ++i;
     }
-    error(lineOf(*node), fmt::format("{}: '{}' is not one of {}", key(path, name), *text, names));
+    std::string_view best;
+    std::size_t bestDistance = 3;
+    for (const auto& v : values) {
+      if (const std::size_t d = editDistance(*text, v.name); d < bestDistance) bestDistance = d, best = v.name;
+    }
+    error(lineOf(*node), fmt::format("{}: '{}' is not one of {}{}", key(path, name), *text, names,
+                                     best.empty() ? std::string() : fmt::format("; did you mean '{}'?", best)));
     return std::nullopt;
   }
 
@@ -1024,9 +1030,9 @@ class Reader {
       }
       ViewSpec v;
       v.line = lineOf(*t);
-      checkKeys(
-          *t, path,
-          {"name", "kind", "cave", "facet", "eye", "viewport", "stereo", "eye_spacing", "projection", "of", "from"});
+      checkKeys(*t, path,
+                {"name", "kind", "cave", "facet", "eye", "viewport", "stereo", "eye_spacing", "projection", "winding",
+                 "of", "from"});
       v.name = string(*t, "name", path).value_or(fmt::format("view {}", index));
       if (!names.insert(v.name).second)
         error(v.line, fmt::format("{}: a view named '{}' already exists", path, v.name));
@@ -1064,6 +1070,15 @@ class Reader {
       if (auto spacing = number(*t, "eye_spacing", path, 0.0, 10.0)) v.eyeSpacing = static_cast<float>(*spacing);
       if (auto projection = choice<bool>(*t, "projection", path, {{"rear", true}, {"front", false}})) {
         v.rearProjection = *projection;
+      }
+      if (auto winding = choice<formats::FacetWinding>(*t, "winding", path,
+                                                       {{"inward", formats::FacetWinding::kInward},
+                                                        {"outward", formats::FacetWinding::kOutward},
+                                                        {"auto", formats::FacetWinding::kAuto}})) {
+        v.winding = *winding;
+      }
+      if (v.kind != ViewKind::kFacet && t->get("winding")) {
+        warning(v.line, fmt::format("{}: winding applies to facet views only", path));
       }
       if (auto eye = choice<Eye>(*t, "eye", path, {{"left", Eye::kLeft}, {"right", Eye::kRight}})) v.eye = *eye;
       if (const toml::node* vp = t->get("viewport")) readViewport(*vp, path, v);

@@ -21,6 +21,7 @@
 #include "runtime/bindings.h"
 #include "runtime/clock.h"
 #include "runtime/error.h"
+#include "runtime/formats/cave.h"
 
 namespace basalt::kiosk {
 
@@ -104,8 +105,11 @@ struct ViewSpec {
   bool facetGiven = false;  ///< facet: `facet` was given (else the cave file's facet[] is used)
   /// plain and facet: how the eyes are shown; "show" follows the show's stereo setting
   enum class Stereo : std::uint8_t { kShow, kOff, kAnaglyph, kSideBySide, kTopBottom } stereo = Stereo::kShow;
-  std::optional<float> eyeSpacing;           ///< facet: distance between the eyes in cave units (default: the show's)
-  bool rearProjection = true;                ///< facet: `projection = "rear"` (the thesis' default) or "front"
+  std::optional<float> eyeSpacing;  ///< facet: distance between the eyes in cave units (default: the show's)
+  bool rearProjection = true;       ///< facet: `projection = "rear"` (the thesis' default) or "front"
+  /// facet: `winding = "inward"` (the thesis' default: the geometry's facets used as written),
+  /// "outward" (every facet turned round) or "auto" (each facet the viewer sees from behind)
+  formats::FacetWinding winding = formats::FacetWinding::kInward;
   std::string of;                            ///< aids: the facet view whose set-up is shown ("" = the first facet view)
   std::optional<std::array<float, 3>> from;  ///< aids: direction the display is seen from (cave axes)
 };

@@ -887,6 +887,11 @@ void ShowDirector::afterPresent(const FrameContext& /*frame*/) {
     performanceUpdates_ = meter.updates;
     context_.board.publishPerformance(meter);
   }
+  // A view that draws nothing: /health says so while it lasts (copied only when it changes).
+  if (views_ && views_->problemsVersion() != viewProblemsSeen_) {
+    viewProblemsSeen_ = views_->problemsVersion();
+    context_.board.setViewProblems(views_->problems());
+  }
   if (texturesPending_) {
     texturesPending_ = false;
     loadTexturesInBackground();

@@ -222,6 +222,7 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   std::string itemKey_;
   std::vector<std::string> texturesBeforeItem_;
   std::uint64_t performanceUpdates_ = 0;  // the meter's sample last published
+  std::uint64_t viewProblemsSeen_ = 0;    // DisplayViews::problemsVersion() last published
   // Frame lock (frame loop only).
   bool locked_ = false;
   bool follower_ = false;  // plays the leader's programme, decides nothing itself

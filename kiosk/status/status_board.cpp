@@ -134,6 +134,11 @@ void StatusBoard::setProblems(std::vector<std::string> problems) {
   problems_ = std::move(problems);
 }
 
+void StatusBoard::setViewProblems(std::vector<std::string> problems) {
+  std::lock_guard lock(mutex_);
+  viewProblems_ = std::move(problems);
+}
+
 void StatusBoard::publishShow(ShowStatus status) {
   std::lock_guard lock(mutex_);
   show_ = std::move(status);
@@ -231,6 +236,7 @@ StatusSnapshot StatusBoard::snapshot(WallTime now) const {
     s.lastReload = lastReload_;
     s.problems = problems_;
     if (!reloadProblem_.empty()) s.problems.push_back(reloadProblem_);
+    s.problems.insert(s.problems.end(), viewProblems_.begin(), viewProblems_.end());
     if (const auto busy = frameWatch_ ? frameWatch_->busy() : std::nullopt) {
       const Nanos running = SystemClock().now() - busy->since;
       if (running >= kStuckFrameAfter) {

@@ -196,6 +196,9 @@ class StatusBoard {
   void noteReload(bool ok, std::string outcome);
   /// \brief What is wrong with the show as it started (its errors, what plays instead).
   void setProblems(std::vector<std::string> problems);
+  /// \brief What is wrong with the display's views (DisplayViews::problems(): a view that draws
+  /// nothing), published when it changes; a reload leaves them (the views outlive the show).
+  void setViewProblems(std::vector<std::string> problems);
   void publishShow(ShowStatus status);
   void publishDevices(std::vector<DeviceStatus> devices);
   void publishStreams(std::vector<StreamStatus> streams);
@@ -262,6 +265,7 @@ class StatusBoard {
   std::string lastReload_;                  // guarded by mutex_
   std::vector<std::string> problems_;       // guarded by mutex_
   std::string reloadProblem_;               // guarded by mutex_
+  std::vector<std::string> viewProblems_;   // guarded by mutex_
   std::function<void()> wake_;              // set before the server starts
   const Clock* showClock_ = nullptr;        // set before the server starts
   const FrameWatch* frameWatch_ = nullptr;  // set before the server starts

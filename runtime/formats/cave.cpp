@@ -3,6 +3,7 @@
 
 #include "runtime/formats/cave.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -15,6 +16,37 @@ namespace basalt::formats {
 namespace {
 
 std::uint32_t col(std::size_t offset) { return static_cast<std::uint32_t>(offset) + 1; }
+
+/// Fills a facet's plane and facing from its measured outline.
+void setShape(CaveFacet& f, const PolygonShape& shape, const Vec3& displayCentre) {
+  f.normal = shape.normal;
+  f.planeOffset = shape.planeOffset;
+  f.area = shape.area;
+  f.longestSide = shape.longestSide;
+  Vec3 centre{0, 0, 0};
+  for (const Vec3& c : f.corners) centre += c;
+  centre = centre / static_cast<float>(f.corners.size());
+  f.facesInward = dot(f.normal, displayCentre - centre) > 0;
+  // The viewer at the origin: its distance in front of the plane is dot(normal, 0) - offset.
+  f.facesViewer = -f.planeOffset > kCaveViewerClearance;
+}
+
+/// "line 9", "lines 9-14" or "lines 9, 12 and 20" (the first eight, then how many more); the
+/// same for facets.
+std::string numberList(std::string_view one, std::string_view many, const std::vector<std::uint32_t>& lines) {
+  if (lines.size() == 1) return fmt::format("{} {}", one, lines.front());
+  bool consecutive = true;
+  for (std::size_t i = 1; i < lines.size(); ++i) consecutive = consecutive && lines[i] == lines[i - 1] + 1;
+  if (consecutive && lines.size() > 2) return fmt::format("{} {}-{}", many, lines.front(), lines.back());
+  constexpr std::size_t kShown = 8;
+  std::string out = fmt::format("{} ", many);
+  const std::size_t shown = std::min(lines.size(), kShown);
+  for (std::size_t i = 0; i < shown; ++i) {
+    out += fmt::format("{}{}", i == 0 ? "" : (i + 1 == shown && shown == lines.size() ? " and " : ", "), lines[i]);
+  }
+  if (shown < lines.size()) out += fmt::format(" and {} more", lines.size() - shown);
+  return out;
+}
 
 }  // namespace
 
@@ -196,20 +228,7 @@ Result<CaveGeometry> parseCaveGeometry(std::string_view text, const std::string&
                                            "(number {} on its 'f' line); cave facets must be convex",
                                            i, shape.reflexCorner, shape.reflexCorner + 1));
     }
-    f.normal = shape.normal;
-    f.planeOffset = shape.planeOffset;
-    f.area = shape.area;
-    f.longestSide = shape.longestSide;
-    Vec3 centre{0, 0, 0};
-    for (const Vec3& c : f.corners) centre += c;
-    centre = centre / static_cast<float>(f.corners.size());
-    f.facesInward = dot(f.normal, geometry.center - centre) > 0;
-    if (!f.facesInward) {
-      d.warn(f.line, 0,
-             fmt::format("facet {} faces outward (its corners run clockwise seen from inside the display); the "
-                         "thesis expects facets that face inward",
-                         i));
-    }
+    setShape(f, shape, geometry.center);
   }
   if (!ignoredLines.empty()) {
     d.warn(ignoredLines.front(), 0,
@@ -276,6 +295,75 @@ Result<LoadedCave> loadCave(const std::filesystem::path& path, const LoadedCave*
   }
   cave.warnings = std::move(warnings);
   return cave;
+}
+
+CaveGeometry windFacets(const CaveGeometry& geometry, FacetWinding winding) {
+  CaveGeometry out = geometry;
+  if (winding == FacetWinding::kInward) return out;
+  for (CaveFacet& f : out.facets) {
+    if (winding == FacetWinding::kAuto && f.facesViewer) continue;
+    std::reverse(f.corners.begin(), f.corners.end());
+    setShape(f, measurePolygon(f.corners), out.center);
+  }
+  return out;
+}
+
+std::optional<Diagnostic> caveFacingProblem(const CaveGeometry& geometry, FacetWinding winding) {
+  const CaveGeometry wound = windFacets(geometry, winding);
+  // Thesis §4.2.1: a face is seen from its front when its corners run counter-clockwise from the
+  // viewer, i.e. when the viewer is on the side its normal points to; §4.4.3: the viewer stands
+  // at the geometry's origin. A facet seen from behind is culled: its view draws nothing.
+  std::vector<std::uint32_t> outward, outwardLines, behind, behindLines;
+  for (std::size_t i = 0; i < wound.facets.size(); ++i) {
+    const CaveFacet& f = wound.facets[i];
+    if (f.facesViewer) continue;
+    // Facing away from the display's centre too: wound the other way. Facing the centre (or the
+    // centre on its plane, a display of one facet): the viewer is outside the display.
+    Vec3 centroid{0, 0, 0};
+    for (const Vec3& c : f.corners) centroid += c;
+    centroid = centroid / static_cast<float>(f.corners.size());
+    const bool woundOutward = dot(f.normal, wound.center - centroid) < 0;
+    (woundOutward ? outward : behind).push_back(static_cast<std::uint32_t>(i));
+    (woundOutward ? outwardLines : behindLines).push_back(f.line);
+  }
+  const std::size_t n = wound.facets.size();
+  const std::string file = geometry.path.string();
+  if (!outward.empty()) {
+    const std::string where = fmt::format("{}:{}", file, outwardLines.front());
+    if (outward.size() == n && winding == FacetWinding::kOutward) {
+      return Diagnostic{where, fmt::format("winding = \"outward\" turns every facet round, but the {} facets of this "
+                                           "geometry face the viewer as written ({}): it is wound inward, as the "
+                                           "thesis wants; remove winding from the facet view or set it to \"inward\"",
+                                           n, numberList("line", "lines", outwardLines))};
+    }
+    if (outward.size() == n) {
+      return Diagnostic{
+          where, fmt::format("{} away from the viewer ({}): the geometry is wound outward, as modelling "
+                             "tools export it (each facet's corners run clockwise seen from inside; the thesis' facets "
+                             "face inward, counter-clockwise), so every view of it draws nothing. Fix: add "
+                             "winding = \"outward\" to the facet view in the show's manifest, or reverse the order of "
+                             "the corners on each 'f' line",
+                             n == 1 ? std::string("its one facet faces") : fmt::format("all {} facets face", n),
+                             numberList("line", "lines", outwardLines))};
+    }
+    return Diagnostic{where,
+                      fmt::format("{} of {} {} away from the viewer ({}): wound outward (corners clockwise seen "
+                                  "from inside), so {} draw nothing. Fix: add winding = \"auto\" to the facet "
+                                  "view in the show's manifest, which turns each facet to face the viewer, or "
+                                  "reverse the order of the corners on {}",
+                                  numberList("facet", "facets", outward), n, outward.size() == 1 ? "faces" : "face",
+                                  numberList("line", "lines", outwardLines),
+                                  outward.size() == 1 ? "its view would" : "their views would",
+                                  outward.size() == 1 ? "that line" : "those lines")};
+  }
+  if (behind.empty()) return std::nullopt;
+  return Diagnostic{
+      fmt::format("{}:{}", file, behindLines.front()),
+      fmt::format("the viewer, at the geometry's origin, is behind or on the plane of {} ({}), which "
+                  "{} the display's inside: the origin is not inside the display, so {} draw nothing. "
+                  "Fix: model the display around its origin (the thesis' viewer stands there)",
+                  numberList("facet", "facets", behind), numberList("line", "lines", behindLines),
+                  behind.size() == 1 ? "faces" : "face", behind.size() == 1 ? "its view would" : "their views would")};
 }
 
 std::optional<std::string> caveSettingsProblem(const CaveSettings& settings, const CaveGeometry& geometry,

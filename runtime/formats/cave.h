@@ -43,7 +43,10 @@ struct CaveFacet {
   float area = 0;
   std::uint32_t longestSide = 0;  ///< side i runs from corner i to corner i+1
   bool facesInward = true;        ///< its front faces the inside of the display (as the thesis wants)
-  std::uint32_t line = 0;         ///< its `f` line in the geometry file
+  /// The thesis' default viewer, the geometry's origin (§4.4.3), is in front of its plane, so it
+  /// sees the facet's front (§4.2.1): only then does a view of the facet draw anything.
+  bool facesViewer = true;
+  std::uint32_t line = 0;  ///< its `f` line in the geometry file
 };
 
 /// \brief A display's geometry: the facets in file order (facet 0 is the first `f`).
@@ -60,6 +63,28 @@ struct LoadedCave {
   std::shared_ptr<const CaveGeometry> geometry;  ///< null until a cave file names a model
   std::vector<Diagnostic> warnings;
 };
+
+/// \brief How far in front of a facet's plane (cave units) the viewer must be to see it: the
+/// facet projection's own test (runtime/facet_projection.cpp).
+inline constexpr float kCaveViewerClearance = 1e-6f;
+
+/// \brief How a display geometry's facets are wound, as a facet view says (`winding` in a
+/// manifest's `[[views]]`).
+enum class FacetWinding : std::uint8_t {
+  kInward,   ///< as the thesis wants (§4.4.1): every facet used as written
+  kOutward,  ///< the usual export of modelling tools: every facet is turned round
+  kAuto,     ///< each facet whose front the viewer cannot see is turned round
+};
+
+/// \brief The geometry with its facets turned as `winding` says: a turned facet has its corners
+/// in the reverse order, so its normal, plane, longest side and facing are those of the same
+/// polygon wound the other way (turning a reversed copy of a file gives back the file's facets).
+[[nodiscard]] CaveGeometry windFacets(const CaveGeometry& geometry, FacetWinding winding);
+
+/// \brief What is wrong with the way `geometry`'s facets face the viewer once `winding` is
+/// applied, as one warning for the whole geometry (it names the facets and their `f` lines and
+/// says how to fix it), or nothing when every facet's front faces the viewer.
+[[nodiscard]] std::optional<Diagnostic> caveFacingProblem(const CaveGeometry& geometry, FacetWinding winding);
 
 /// \brief Tolerance of the flatness check: corners may be this fraction of the facet's size
 /// off its plane.

@@ -2,8 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "runtime/math.h"
@@ -105,6 +108,23 @@ std::string icositetrahedronDisplayObj() {
     }
   }
   return toObj(walls);
+}
+
+std::string reverseFacetWinding(const std::string& obj) {
+  std::istringstream in(obj);
+  std::string out, line;
+  while (std::getline(in, line)) {
+    if (line.rfind("f ", 0) == 0) {
+      std::istringstream words(line.substr(2));
+      std::vector<std::string> corners;
+      for (std::string w; words >> w;) corners.push_back(w);
+      std::reverse(corners.begin(), corners.end());
+      line = "f";
+      for (const std::string& c : corners) line += " " + c;
+    }
+    out += line + "\n";
+  }
+  return out;
 }
 
 }  // namespace basalt::test

@@ -18,4 +18,9 @@ std::string prismDisplayObj();
 /// \brief The trapezoidal icositetrahedron: the dual of the rhombicuboctahedron, 24 kites.
 std::string icositetrahedronDisplayObj();
 
+/// \brief The same OBJ text with every `f` line's corners in the reverse order ("f 1 2 3 4"
+/// becomes "f 4 3 2 1"): facets facing outward, as modelling tools export a room; other lines
+/// are kept as they are.
+std::string reverseFacetWinding(const std::string& obj);
+
 }  // namespace basalt::test

@@ -12,6 +12,8 @@
 #include <sstream>
 
 #include "kiosk/loop/display_views.h"
+#include "runtime/image.h"
+#include "runtime/log.h"
 #include "support/polyhedra.h"
 #include "support/render_fixture.h"
 #include "support/test_paths.h"
@@ -336,6 +338,87 @@ TEST(DisplayViewsManifest, AidsViewKeysAreReadAndChecked) {
   EXPECT_FALSE(
       kiosk::readManifestText(facet + "[[views]]\nkind = \"aids\"\nfrom = [0, 0, 0]\n", folder / "show.toml", zero));
   EXPECT_NE(zero.format().find("from: must be a direction"), std::string::npos) << zero.format();
+}
+
+// ---- Display geometry wound outward ------------------------------------------------------------
+
+// Collects the views' log records (the views' category) while it lives.
+class ViewLog {
+ public:
+  ViewLog() { log::addSink(sink_); }
+  ~ViewLog() { log::removeSink(sink_); }
+  ViewLog(const ViewLog&) = delete;
+  ViewLog& operator=(const ViewLog&) = delete;
+  [[nodiscard]] std::size_t count(const std::string& needle) const {
+    std::size_t n = 0;
+    for (const log::Record& r : sink_->snapshot()) n += r.message.find(needle) != std::string::npos ? 1U : 0U;
+    return n;
+  }
+
+ private:
+  std::shared_ptr<log::RingSink> sink_ = std::make_shared<log::RingSink>(512);
+};
+
+// Makes sure a display geometry wound outward (each facet's corners reversed, as modelling tools
+// export it) draws, with winding = "outward", the same six facet views as the same display wound
+// inward, and that "auto" does too. Example failures: turned facets whose base side moved (each
+// wall turned a quarter); the aids or the projection still using the outward facets (black views).
+TEST_F(DisplayViewsTest, AnOutwardDisplayTurnedDrawsWhatTheInwardOneDraws) {
+  std::ofstream(folder_ / "outward.obj") << reverseFacetWinding(cubeDisplayObj());
+  std::ofstream(folder_ / "outward.cave") << "model outward.obj\nfacet[5]\n";
+  runtime::Show show = runtime::Show::makeDefault();
+  show.global().background = {0.3f, 0.4f, 0.5f};
+  auto inward = kiosk::DisplayViews::create(sixFacets(), renderer(), output().size());
+  ASSERT_TRUE(inward) << inward.error().describe();
+  const Image expected = draw(**inward, show);
+  for (const formats::FacetWinding winding : {formats::FacetWinding::kOutward, formats::FacetWinding::kAuto}) {
+    std::vector<kiosk::ViewSpec> specs = sixFacets();
+    for (kiosk::ViewSpec& s : specs) s.cave = folder_ / "outward.cave", s.winding = winding;
+    auto turned = kiosk::DisplayViews::create(specs, renderer(), output().size());
+    ASSERT_TRUE(turned) << turned.error().describe();
+    const Image actual = draw(**turned, show);
+    const ImageDifference diff = compareImages(expected, actual, 2);
+    EXPECT_TRUE(diff.sameShape);
+    EXPECT_EQ(diff.pixelsOverTolerance, 0u) << "largest difference " << diff.maxChannelDelta;
+    EXPECT_TRUE((*turned)->problems().empty()) << (*turned)->problems().front();
+  }
+  // The inward picture is not black (else the comparison would prove nothing).
+  std::size_t lit = 0;
+  for (std::size_t i = 0; i < expected.pixels.size(); ++i) lit += expected.pixels[i] > 16 ? 1U : 0U;
+  EXPECT_GT(lit, expected.pixels.size() / 4);
+}
+
+// Makes sure an outward display without the option is reported once per view that draws nothing
+// (not once per frame), with the fix, and listed in problems() (what /health shows) while it lasts.
+// Example failures: a black view with nothing in the log; the warning every frame (60 a second);
+// problems() empty, so /health says "ok" over a black wall.
+TEST_F(DisplayViewsTest, AnOutwardDisplayWithoutTheOptionIsReportedOnce) {
+  std::ofstream(folder_ / "outward.obj") << reverseFacetWinding(cubeDisplayObj());
+  std::ofstream(folder_ / "outward.cave") << "model outward.obj\nfacet[5]\n";
+  kiosk::ViewSpec one;
+  one.name = "front wall";
+  one.kind = kiosk::ViewKind::kFacet;
+  one.cave = folder_ / "outward.cave";
+  ViewLog log;
+  auto views = kiosk::DisplayViews::create({one}, renderer(), output().size());
+  ASSERT_TRUE(views) << views.error().describe();
+  runtime::Show show = runtime::Show::makeDefault();
+  show.global().background = {0.3f, 0.4f, 0.5f};
+  const std::uint64_t before = (*views)->problemsVersion();
+  Image image;
+  for (int frame = 0; frame < 5; ++frame) image = draw(**views, show);
+  // Black: the viewer sees every facet from behind.
+  std::size_t lit = 0;
+  for (std::size_t i = 0; i < image.pixels.size(); i += 4) {
+    lit += image.pixels[i] + image.pixels[i + 1] + image.pixels[i + 2] > 0 ? 1U : 0U;
+  }
+  EXPECT_EQ(lit, 0u);
+  EXPECT_EQ(log.count("view 'front wall' draws nothing"), 1u);
+  EXPECT_EQ(log.count("winding = \"outward\""), 1u);
+  ASSERT_EQ((*views)->problems().size(), 1u);
+  EXPECT_NE((*views)->problems()[0].find("view 'front wall' draws nothing: facet 5 of outward.obj"), std::string::npos)
+      << (*views)->problems()[0];
+  EXPECT_EQ((*views)->problemsVersion(), before + 1) << "changed once, not per frame";
 }
 
 }  // namespace

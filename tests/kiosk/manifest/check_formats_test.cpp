@@ -7,11 +7,15 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "kiosk/manifest/check_formats.h"
 #include "kiosk/manifest/manifest.h"
+#include "support/polyhedra.h"
 #include "support/process.h"
 #include "support/test_paths.h"
 
@@ -87,6 +91,75 @@ TEST(CheckFormats, ScenesAndCavesGoodAndBroken) {
   EXPECT_NE(broken.output.find((dir / "broken.cave").string() + ":1: error: column 7: 'zero' is not a facet index"),
             std::string::npos)
       << broken.output;
+}
+
+std::size_t count(const std::string& text, const std::string& needle) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
+  return n;
+}
+
+// Makes sure `basalt check` says once, with the geometry file and its `f` lines, that an
+// outward-wound display (each facet's corners reversed from the test cube's) faces away from the
+// viewer, and offers the fix; and that a manifest whose facet views set winding = "outward" is
+// clean, while one without it is told once however many views show the display.
+// Thesis §4.2.1: "If its vertices are oriented in clockwise order from the point of view of the
+// viewer, they represent a back-face, and are not drawn (culled)." §4.4.3: "The default viewer
+// position is the origin of the display geometry."
+// Example failures: one warning per facet (32 for a soccer-ball display); a warning with no line;
+// the warning repeated for each of six views; the option not silencing it.
+TEST(CheckFormats, AnOutwardWoundDisplayIsNamedOnceWithTheFix) {
+  const fs::path dir = test::scratchDir("check-formats-outward");
+  writeFile(dir / "inward.obj", test::cubeDisplayObj());
+  writeFile(dir / "outward.obj", test::reverseFacetWinding(test::cubeDisplayObj()));
+  writeFile(dir / "inward.cave", "model inward.obj\n");
+  writeFile(dir / "outward.cave", "model outward.obj\nfacet[5]\n");
+  // The `f` lines of the generated cube, counted here rather than taken from the checker.
+  std::vector<int> faceLines;
+  {
+    std::istringstream in(test::cubeDisplayObj());
+    int n = 0;
+    for (std::string line; std::getline(in, line);) {
+      ++n;
+      if (line.rfind("f ", 0) == 0) faceLines.push_back(n);
+    }
+  }
+  ASSERT_EQ(faceLines.size(), 6u);
+  const std::string lines = fmt::format("lines {}-{}", faceLines.front(), faceLines.back());
+
+  const auto good = check({dir / "inward.cave"});
+  EXPECT_EQ(good.exitCode, 0) << good.output;
+  EXPECT_NE(good.output.find("inward.cave: no errors"), std::string::npos) << good.output;
+  const auto bad = check({dir / "outward.cave"});
+  EXPECT_EQ(bad.exitCode, 0) << "a warning, not an error: " << bad.output;
+  EXPECT_EQ(count(bad.output, "warning:"), 1u) << bad.output;
+  EXPECT_NE(bad.output.find(fmt::format("{}:{}: warning: all 6 facets face away from the viewer ({})",
+                                        (dir / "outward.obj").string(), faceLines.front(), lines)),
+            std::string::npos)
+      << bad.output;
+  EXPECT_NE(bad.output.find("winding = \"outward\""), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("0 errors, 1 warning"), std::string::npos) << bad.output;
+
+  const std::string views =
+      "[[views]]\nname = \"front\"\nkind = \"facet\"\ncave = \"outward.cave\"\n{}"
+      "[[views]]\nname = \"back\"\nkind = \"facet\"\ncave = \"outward.cave\"\nfacet = 4\n{}";
+  writeFile(dir / "plain.toml", fmt::format(fmt::runtime(views), "", ""));
+  const auto plain = check({dir / "plain.toml"});
+  EXPECT_EQ(count(plain.output, "warning:"), 1u) << plain.output;
+  EXPECT_NE(plain.output.find(fmt::format("{}:{}: warning: facet view 'front': all 6 facets face away",
+                                          (dir / "outward.obj").string(), faceLines.front())),
+            std::string::npos)
+      << plain.output;
+  const std::string option = "winding = \"outward\"\n";
+  writeFile(dir / "turned.toml", fmt::format(fmt::runtime(views), option, option));
+  const auto turned = check({dir / "turned.toml"});
+  EXPECT_EQ(turned.exitCode, 0) << turned.output;
+  EXPECT_EQ(count(turned.output, "warning:"), 0u) << turned.output;
+  // The option on the inward file is the mistake then.
+  writeFile(dir / "wrong.toml", "[[views]]\nname = \"a\"\nkind = \"facet\"\ncave = \"inward.cave\"\n" + option);
+  const auto wrong = check({dir / "wrong.toml"});
+  EXPECT_EQ(count(wrong.output, "warning:"), 1u) << wrong.output;
+  EXPECT_NE(wrong.output.find("it is wound inward"), std::string::npos) << wrong.output;
 }
 
 TEST(CheckFormats, AManifestsSceneAndModelAreParsed) {

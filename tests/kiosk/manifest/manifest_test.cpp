@@ -710,6 +710,31 @@ TEST(ManifestErrors, OutputsAndViews) {
   EXPECT_EQ(ok.manifest->views[0].facet, 2u);
 }
 
+// Makes sure a facet view's `winding` is read with its three values and a "did you mean" for a
+// mistyped key or value. Example failures: "outwards" silently read as the default (the view stays
+// black); a typo of the key accepted.
+TEST(ManifestErrors, FacetWindingIsOneOfThreeWithSuggestions) {
+  ShowFolder f("winding");
+  const auto ok = f.read(
+      "[[views]]\nname = \"a\"\nkind = \"facet\"\ncave = \"room.cave\"\nwinding = \"outward\"\n"
+      "[[views]]\nname = \"b\"\nkind = \"facet\"\ncave = \"room.cave\"\nwinding = \"auto\"\n"
+      "[[views]]\nname = \"c\"\nkind = \"facet\"\ncave = \"room.cave\"\n");
+  ASSERT_TRUE(ok.manifest) << ok.text;
+  EXPECT_EQ(ok.manifest->views[0].winding, formats::FacetWinding::kOutward);
+  EXPECT_EQ(ok.manifest->views[1].winding, formats::FacetWinding::kAuto);
+  EXPECT_EQ(ok.manifest->views[2].winding, formats::FacetWinding::kInward) << "the thesis' default";
+  const auto bad = f.read(
+      "[[views]]\nname = \"a\"\nkind = \"facet\"\ncave = \"room.cave\"\nwinding = \"outwards\"\n"  // 1-5
+      "[[views]]\nname = \"b\"\nkind = \"facet\"\ncave = \"room.cave\"\nwindng = \"auto\"\n"       // 6-10
+      "[[views]]\nname = \"c\"\nwinding = \"auto\"\n");                                            // 11-13
+  EXPECT_FALSE(bad.manifest);
+  EXPECT_TRUE(
+      hasError(bad, 5, "views[0].winding: 'outwards' is not one of inward, outward or auto; did you mean 'outward'?"))
+      << bad.text;
+  EXPECT_TRUE(hasError(bad, 10, "views[1].windng: unknown key; did you mean 'winding'?")) << bad.text;
+  EXPECT_TRUE(hasWarning(bad, 11, "views[2]: winding applies to facet views only")) << bad.text;
+}
+
 TEST(ManifestErrors, AnEmptyManifestPlaysTheDefaultShow) {
   ShowFolder f("empty");
   const auto r = f.read("");

@@ -546,6 +546,63 @@ token_file = "token"
   EXPECT_EQ(::kill(show->process().pid(), 0), 0) << "the show still runs";
 }
 
+// ---- A view that draws nothing --------------------------------------------------------------
+
+// Makes sure a facet view of a display wound outward (each facet's corners reversed from the test
+// cube's), with no `winding` to turn it, makes /health "degraded" with a problem naming the view,
+// and is logged once, not once a frame; and that with winding = "outward" the same show is "ok".
+// Example failures: a black wall while /health says "ok"; last_errors full of the same line.
+TEST(StatusServerViews, AViewThatDrawsNothingIsAProblemSaidOnce) {
+  std::string why;
+  if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  const std::string manifest = R"(
+[show]
+name = "Outward display"
+entry = "default"
+fps = 30
+
+[output]
+kind = "headless"
+size = "160x120"
+
+[[views]]
+name = "front"
+kind = "facet"
+cave = "display.cave"
+{}
+[status]
+listen = "127.0.0.1:0"
+)";
+  for (const bool turned : {false, true}) {
+    const auto dir = test::writeShow(turned ? "status-views-turned" : "status-views-outward",
+                                     fmt::format(fmt::runtime(manifest), turned ? "winding = \"outward\"" : ""));
+    std::ofstream(dir / "display.obj") << test::reverseFacetWinding(test::cubeDisplayObj());
+    std::ofstream(dir / "display.cave") << "model display.obj\nfacet[5]\n";
+    auto show = test::RunningShow::start({(dir / "show.toml").string(), "--realtime", "--no-resume"}, {}, why);
+    ASSERT_TRUE(show) << why;
+    ::usleep(1000000);  // about 30 frames
+    const auto h = show->get("/health");
+    ASSERT_EQ(h.status, 200) << h.body;
+    const auto health = nlohmann::json::parse(h.body);
+    std::size_t problems = 0, logged = 0;
+    for (const auto& p : health["problems"]) {
+      problems += p.get<std::string>().find("view 'front' draws nothing") != std::string::npos ? 1U : 0U;
+    }
+    for (const auto& e : health["last_errors"]) {
+      logged += e["message"].get<std::string>().find("view 'front' draws nothing") != std::string::npos ? 1U : 0U;
+    }
+    if (turned) {
+      EXPECT_EQ(health["state"], "ok") << h.body;
+      EXPECT_EQ(problems, 0u) << h.body;
+      EXPECT_EQ(logged, 0u) << h.body;
+    } else {
+      EXPECT_EQ(health["state"], "degraded") << h.body;
+      EXPECT_EQ(problems, 1u) << h.body;
+      EXPECT_EQ(logged, 1u) << h.body;
+    }
+  }
+}
+
 // ---- The page in a browser -----------------------------------------------------------------
 
 /// Runs headless Chromium on `url` in a window of `width` x `height` with `extra` arguments;

@@ -122,7 +122,7 @@ TEST(CaveGeometry, TwistedConcaveAndDegenerateFacetsAreRejectedByNumber) {
   }
 }
 
-TEST(CaveGeometry, OutwardFacetsAndOtherStatementsAreWarnedAbout) {
+TEST(CaveGeometry, OtherStatementsAreWarnedAboutAndOutwardFacetsMarked) {
   std::vector<Diagnostic> warnings;
   // The cube with its last facet's corners reversed (facing out), plus normals that are ignored.
   std::string text = kCube;
@@ -131,9 +131,130 @@ TEST(CaveGeometry, OutwardFacetsAndOtherStatementsAreWarnedAbout) {
   auto g = geometry(text, warnings);
   ASSERT_TRUE(g) << g.error().describe();
   EXPECT_FALSE(g->facets[5].facesInward);
-  EXPECT_TRUE(test::hasWarning(warnings, "facet 5 faces outward")) << test::listWarnings(warnings);
+  // The facing is said once for the whole geometry (caveFacingProblem), not per facet here.
+  EXPECT_FALSE(test::hasWarning(warnings, "facet 5")) << test::listWarnings(warnings);
+  EXPECT_EQ(warnings.size(), 1u) << test::listWarnings(warnings);
   EXPECT_TRUE(test::hasWarning(warnings, "2 statements other than 'v' and 'f' were ignored"))
       << test::listWarnings(warnings);
+}
+
+// The facing rules come from the thesis, not from the code under test:
+//   §4.2.1: "If its vertices are oriented in clockwise order from the point of view of the
+//   viewer, they represent a back-face, and are not drawn (culled)."
+//   §4.4.3: "The default viewer position is the origin of the display geometry."
+//   §4.4.1: "limiting it to a convex polyhedron ... with all facets facing inward ensures that
+//   each facet is visible from any position within the SID."
+// A cube -1..1 around the origin wound inward, and the same file with each `f` line reversed.
+constexpr const char* kCentredCube =
+    "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+    "f 2 6 7 3\nf 5 1 4 8\nf 4 3 7 8\nf 1 5 6 2\nf 6 5 8 7\nf 1 2 3 4\n";
+
+std::string reversed(std::string_view obj) {
+  std::string out;
+  std::size_t at = 0;
+  while (at < obj.size()) {
+    const std::size_t end = obj.find('\n', at);
+    std::string line(obj.substr(at, end - at));
+    at = end == std::string_view::npos ? obj.size() : end + 1;
+    if (line.rfind("f ", 0) == 0) {
+      std::vector<std::string> corners;
+      for (std::size_t p = 2; p < line.size();) {
+        const std::size_t space = std::min(line.find(' ', p), line.size());
+        corners.push_back(line.substr(p, space - p));
+        p = space + 1;
+      }
+      line = "f";
+      for (auto c = corners.rbegin(); c != corners.rend(); ++c) line += " " + *c;
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
+// Makes sure an outward-wound display (the usual export of modelling tools) is told apart from
+// an inward one by where the thesis' viewer stands, said in one warning that names the file and
+// every facet's line and offers both fixes. Example failures: one warning per facet (32 for a
+// truncated icosahedron); no line; an inward display flagged.
+TEST(CaveFacing, AnOutwardWoundDisplayIsSaidOnceWithItsLinesAndTheFix) {
+  std::vector<Diagnostic> warnings;
+  auto inward = geometry(kCentredCube, warnings);
+  ASSERT_TRUE(inward) << inward.error().describe();
+  EXPECT_FALSE(caveFacingProblem(*inward, FacetWinding::kInward));
+  auto outward = geometry(reversed(kCentredCube), warnings);
+  ASSERT_TRUE(outward) << outward.error().describe();
+  EXPECT_TRUE(warnings.empty()) << test::listWarnings(warnings);
+  // The viewer at the origin is on the back of every facet: dot(normal, 0) - offset < 0.
+  for (const CaveFacet& f : outward->facets) {
+    EXPECT_LT(dot(f.normal, Vec3{0, 0, 0}) - f.planeOffset, 0.0f) << f.line;
+    EXPECT_FALSE(f.facesViewer) << f.line;
+  }
+  const auto problem = caveFacingProblem(*outward, FacetWinding::kInward);
+  ASSERT_TRUE(problem);
+  EXPECT_EQ(problem->where, "cave.obj:9");
+  EXPECT_NE(problem->message.find("all 6 facets face away from the viewer (lines 9-14)"), std::string::npos)
+      << problem->message;
+  EXPECT_NE(problem->message.find("winding = \"outward\""), std::string::npos) << problem->message;
+  EXPECT_NE(problem->message.find("reverse the order of the corners"), std::string::npos) << problem->message;
+  // Said the right way round: with the option the outward file is fine, the inward one is not.
+  EXPECT_FALSE(caveFacingProblem(*outward, FacetWinding::kOutward));
+  EXPECT_FALSE(caveFacingProblem(*outward, FacetWinding::kAuto));
+  const auto backwards = caveFacingProblem(*inward, FacetWinding::kOutward);
+  ASSERT_TRUE(backwards);
+  EXPECT_NE(backwards->message.find("wound inward"), std::string::npos) << backwards->message;
+  EXPECT_FALSE(caveFacingProblem(*inward, FacetWinding::kAuto));
+}
+
+// Makes sure turning an outward-wound display's facets gives exactly the inward file's facets
+// (same corners in the same order, so the same longest side, normal and plane), and that "auto"
+// turns only the facets seen from behind. Example failures: a turned facet whose longest side
+// moved (the picture turned by 90 degrees on a square wall); "auto" turning good facets.
+TEST(CaveFacing, TurningAnOutwardDisplayGivesTheInwardOne) {
+  std::vector<Diagnostic> warnings;
+  auto inward = geometry(kCentredCube, warnings);
+  auto outward = geometry(reversed(kCentredCube), warnings);
+  ASSERT_TRUE(inward && outward);
+  const CaveGeometry turned = windFacets(*outward, FacetWinding::kOutward);
+  ASSERT_EQ(turned.facets.size(), inward->facets.size());
+  for (std::size_t i = 0; i < turned.facets.size(); ++i) {
+    const CaveFacet& a = turned.facets[i];
+    const CaveFacet& b = inward->facets[i];
+    EXPECT_EQ(a.corners, b.corners) << i;
+    EXPECT_EQ(a.normal, b.normal) << i;
+    EXPECT_EQ(a.planeOffset, b.planeOffset) << i;
+    EXPECT_EQ(a.longestSide, b.longestSide) << i;
+    EXPECT_TRUE(a.facesViewer && a.facesInward) << i;
+    EXPECT_EQ(a.line, b.line) << i;
+  }
+  // One facet reversed: "auto" turns that one only; the message names it and its line.
+  std::string mixed = kCentredCube;
+  mixed.replace(mixed.find("f 4 3 7 8"), 9, "f 8 7 3 4");
+  auto one = geometry(mixed, warnings);
+  ASSERT_TRUE(one);
+  const auto problem = caveFacingProblem(*one, FacetWinding::kInward);
+  ASSERT_TRUE(problem);
+  EXPECT_EQ(problem->where, "cave.obj:11");
+  EXPECT_NE(problem->message.find("facet 2 of 6 faces away from the viewer (line 11)"), std::string::npos)
+      << problem->message;
+  EXPECT_NE(problem->message.find("winding = \"auto\""), std::string::npos) << problem->message;
+  const CaveGeometry fixed = windFacets(*one, FacetWinding::kAuto);
+  for (std::size_t i = 0; i < fixed.facets.size(); ++i) EXPECT_EQ(fixed.facets[i].corners, inward->facets[i].corners);
+  EXPECT_FALSE(caveFacingProblem(*one, FacetWinding::kAuto));
+}
+
+// Makes sure a display wound inward whose origin (the viewer) lies outside it is not called
+// outward-wound: the fix there is the model's placement, not its winding.
+TEST(CaveFacing, AViewerOutsideTheDisplayIsNotCalledAWindingProblem) {
+  std::vector<Diagnostic> warnings;
+  // The 0..1 cube: the origin is a corner, on the planes of facets 0, 2 and 4.
+  auto g = geometry(kCube, warnings);
+  ASSERT_TRUE(g);
+  const auto problem = caveFacingProblem(*g, FacetWinding::kInward);
+  ASSERT_TRUE(problem);
+  EXPECT_NE(problem->message.find("the viewer, at the geometry's origin, is behind or on the plane of facets 0, 2 "
+                                  "and 4 (lines 9, 11 and 13)"),
+            std::string::npos)
+      << problem->message;
+  EXPECT_EQ(problem->message.find("winding"), std::string::npos) << problem->message;
 }
 
 TEST(CaveFiles, LoadValidateAndReadInSuccession) {
