@@ -609,8 +609,10 @@ void ShowDirector::updateStreams(Nanos now) {
     const bool live = t.stream->update(now, context_.renderer.textures(), t.name);
     if (follower_) countLeaderFrame(t.stream->leaderFrameResult());
     const std::optional<SourceState> device = t.stream->deviceState();
-    if (live == t.live && device == t.deviceState) continue;
+    const bool degraded = t.stream->degraded();
+    if (live == t.live && device == t.deviceState && degraded == t.degraded) continue;
     t.deviceState = device;
+    t.degraded = degraded;
     t.since = context_.clock.wallNow();
     changed = true;
     if (live == t.live) continue;
@@ -967,6 +969,8 @@ void ShowDirector::publishStreams() {
     // A camera that is gone while its texture shows the on_loss picture is not playing.
     if (t.deviceState == SourceState::kLost) s.state = "lost";
     if (t.deviceState == SourceState::kWaiting) s.state = "waiting";
+    // Its content is broken (a movie file emptied, cut short or deleted): it waits for a good file.
+    if (t.degraded) s.state = "degraded";
     s.message = t.stream ? t.stream->describe() : t.streamState;
     if (!t.live) s.message += t.image ? "; showing the fallback image" : "; showing black";
     s.since = t.since == WallTime{} ? wall : t.since;
