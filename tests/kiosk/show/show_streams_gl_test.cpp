@@ -13,7 +13,9 @@
 // `basalt record`'s Matroska camera video replays frame for frame, bit for bit, at the recorded
 // microsecond; a camera delivering MJPEG (the synthetic one's JPEG-encoded colour bars) shows
 // the same picture as its raw twin, decoded on another thread than the frame loop's, and a
-// corrupt JPEG is counted in its status while the next good frame shows.
+// corrupt JPEG is counted in its status while the next good frame shows; a movie file emptied,
+// cut short, replaced or deleted under the show shows the fallback with one log line, "degraded",
+// no busy retry, and plays again when a good file is back (a good replacement switches at once).
 // Example failures: a factory that is never registered (streams stay "absent"); a movie texture
 // that stays on its fallback; a replayed knob whose events never reach the bindings; a missing
 // device that crashes the show or is reported without its reason; a VCR command that is ignored;
