@@ -299,6 +299,7 @@ struct MoviePlayer::Impl {
       error = e;
     }
     progressCv.notify_all();
+    if (!options.logFailures) return;
     log::error(kLogMedia, "{}: {}; showing the fallback texture (load the movie again to retry)", options.name,
                e.describe());
   }

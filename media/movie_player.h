@@ -66,6 +66,10 @@ struct MoviePlayerOptions {
   /// four frame durations, if longer) has stalled: its pipeline is built again and resumes at
   /// the next frame, so that a kiosk's texture keeps moving.
   std::chrono::milliseconds stallTimeout{5000};
+  /// Logs a failure (state() becomes kFailed) as an error naming the file. A caller that says
+  /// itself what failed and what shows instead (a kiosk's texture stream) turns it off, so that
+  /// one failure is one log line.
+  bool logFailures = true;
 };
 
 /// \brief Counters for the status server and tests.

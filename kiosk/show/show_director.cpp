@@ -6,6 +6,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <mutex>
@@ -22,6 +23,19 @@ namespace basalt::kiosk {
 BASALT_LOG_CATEGORY(Director, "kiosk");
 
 namespace {
+
+/// True when `file` is there but holds nothing but white space: read as a show it would be the
+/// built-in default, which a reload must not put in place of the show playing (a manifest
+/// emptied by mistake, or caught between an editor's truncate and its write).
+bool blankManifest(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;  // missing or unreadable: the reader says so
+  char c = 0;
+  while (in.get(c)) {
+    if (c != ' ' && c != '\t' && c != '\n' && c != '\r') return false;
+  }
+  return true;
+}
 
 constexpr Nanos kSaveEvery = std::chrono::seconds(2);
 
@@ -221,7 +235,11 @@ void ShowDirector::requestReload() {
   const std::filesystem::path file = show_->manifest.file;
   loader_ = std::thread([this, file] {
     Diagnostics diagnostics;
-    auto loaded = readAndLoadShow(file, context_.clock, factories_, diagnostics);
+    Result<std::unique_ptr<LoadedShow>> loaded =
+        blankManifest(file)
+            ? fail(Errc::kParse, "the manifest is empty; save the show again (an empty file is not read as a show)",
+                   file.string())
+            : readAndLoadShow(file, context_.clock, factories_, diagnostics);
     {
       std::lock_guard lock(reloadMutex_);
       reloadReady_ = true;
@@ -232,8 +250,13 @@ void ShowDirector::requestReload() {
         }
       } else {
         reloadError_ = loaded.error().describe();
+        // The status shows the first error itself, so that /health says why, not only how many.
+        bool first = true;
         for (const Diagnostic& d : diagnostics.items()) {
-          if (d.severity == Severity::kError) log::error(kLogDirector, "{}", d.format());
+          if (d.severity != Severity::kError) continue;
+          log::error(kLogDirector, "{}", d.format());
+          if (first) reloadError_ += ": " + d.format();
+          first = false;
         }
       }
     }
@@ -609,8 +632,10 @@ void ShowDirector::updateStreams(Nanos now) {
     const bool live = t.stream->update(now, context_.renderer.textures(), t.name);
     if (follower_) countLeaderFrame(t.stream->leaderFrameResult());
     const std::optional<SourceState> device = t.stream->deviceState();
-    if (live == t.live && device == t.deviceState) continue;
+    const bool degraded = t.stream->degraded();
+    if (live == t.live && device == t.deviceState && degraded == t.degraded) continue;
     t.deviceState = device;
+    t.degraded = degraded;
     t.since = context_.clock.wallNow();
     changed = true;
     if (live == t.live) continue;
@@ -972,6 +997,8 @@ void ShowDirector::publishStreams() {
     // A camera that is gone while its texture shows the on_loss picture is not playing.
     if (t.deviceState == SourceState::kLost) s.state = "lost";
     if (t.deviceState == SourceState::kWaiting) s.state = "waiting";
+    // Its content is broken (a movie file emptied, cut short or deleted): it waits for a good file.
+    if (t.degraded) s.state = "degraded";
     s.message = t.stream ? t.stream->describe() : t.streamState;
     if (!t.live) s.message += t.image ? "; showing the fallback image" : "; showing black";
     s.since = t.since == WallTime{} ? wall : t.since;

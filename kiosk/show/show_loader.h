@@ -48,6 +48,11 @@ class TextureStream {
   virtual bool update(Nanos showTime, render::TextureRegistry& textures, const std::string& name) = 0;
   /// \brief One line for the status page: state and why.
   [[nodiscard]] virtual std::string describe() const = 0;
+  /// \brief True while the stream's own content is broken (a movie file emptied, cut short,
+  /// replaced by one that cannot play, or deleted): the fallback shows, the status says
+  /// "degraded", and the stream waits for a good file. False for streams that are merely
+  /// waiting (not started, a camera being opened).
+  [[nodiscard]] virtual bool degraded() const { return false; }
   /// \brief A camera's own state as of the last update() (it can be lost while the texture
   /// still shows something: its on_loss picture); none for streams without a device.
   [[nodiscard]] virtual std::optional<SourceState> deviceState() const { return std::nullopt; }
@@ -141,7 +146,8 @@ struct LoadedTexture {
   std::string streamState;                 ///< why there is no stream, when there is none
   bool live = false;                       ///< kept by the director
   std::optional<SourceState> deviceState;  ///< the stream's deviceState() at the last update
-  WallTime since{};                        ///< when `live` or `deviceState` last changed (kept by the director)
+  bool degraded = false;                   ///< the stream's degraded() at the last update
+  WallTime since{};  ///< when `live`, `deviceState` or `degraded` last changed (kept by the director)
 };
 
 /// \brief Everything a manifest needs to play.

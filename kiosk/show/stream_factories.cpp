@@ -1,7 +1,10 @@
 #include "kiosk/show/stream_factories.h"
 
+#include "kiosk/show/file_watch.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/trace_video_glue.h"
+
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <atomic>
@@ -33,6 +36,36 @@ namespace {
 // ---------------------------------------------------------------------------------------------
 // Movies
 
+/// What identifies the content of a file: a rename puts another inode under the name, a write
+/// in place changes its size or modification time.
+struct FileIdentity {
+  dev_t device = 0;
+  ino_t inode = 0;
+  off_t size = 0;
+  std::int64_t modifiedNs = 0;
+  bool operator==(const FileIdentity&) const = default;
+};
+
+std::optional<FileIdentity> identify(const std::filesystem::path& file) {
+  struct stat st{};
+  if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+  return FileIdentity{st.st_dev, st.st_ino, st.st_size,
+                      static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec};
+}
+
+/// How long a file that is being written must be quiet before it is tried (a copy in place
+/// sends IN_MODIFY for every write; IN_CLOSE_WRITE ends the wait at once).
+constexpr Nanos kWriteQuiet = std::chrono::seconds(1);
+/// Where inotify cannot watch the file's folder, the file is looked at on this back-off.
+constexpr Nanos kLookFirst = std::chrono::seconds(1);
+constexpr Nanos kLookMost = std::chrono::seconds(30);
+
+/// A movie file on a texture. The file may change under the running show
+/// (docs/decisions/0062-content-changed-under-a-running-show.md): emptied, cut short, replaced
+/// by rename or deleted. Its folder is watched (FileWatch), and a change is acted on at once:
+/// the new content is loaded (a replaced file switches immediately, not at the loop's end),
+/// a file that is gone or cannot play leaves the stream *degraded* with the fallback showing
+/// and one log line, and the stream waits, doing nothing, until the file changes again.
 class MovieStream final : public TextureStream {
  public:
   MovieStream(MediaSpec media, std::unique_ptr<media::MoviePlayer> player, bool manualClock)
@@ -42,15 +75,13 @@ class MovieStream final : public TextureStream {
     leaderResult_ = LeaderFrameResult::kNone;
     if (!started_) {
       started_ = true;
-      if (auto r = player_->load(media_.file); !r) {
-        failure_ = r.error().message();
-        log::error(kLogStreams, "movie '{}': {}; its textures show their fallback", media_.name, r.error().describe());
-        return false;
-      }
-      player_->setRepeat(media_.loop);
-      player_->play();
+      watchFile(showTime);
+      startPlaying("");
+    } else {
+      lookAtFile(showTime);
     }
     if (!failure_.empty()) return false;
+    if (!broken_.empty() && !retrying_) return false;
     if (!texture_) {
       auto texture = render::StreamTexture::create(name);
       if (!texture) {
@@ -79,14 +110,11 @@ class MovieStream final : public TextureStream {
     leaderResult_ = pick.outcome;
     const media::MovieState state = player_->state();
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) {
-      if (!reportedFailure_) {
-        reportedFailure_ = true;
-        const auto error = player_->error();
-        log::error(kLogStreams, "movie '{}' cannot play: {}; its textures show their fallback", media_.name,
-                   error ? error->describe() : std::string("nothing is loaded"));
-      }
+      const auto error = player_->error();
+      fileBroken(fmt::format("cannot play: {}", error ? error->message() : std::string("nothing is loaded")));
       return false;
     }
+    if (retrying_ && !frame) return false;  // the good file's first frame, not the old one's last
     auto changed = texture_->update(frame);
     if (!changed) {
       failure_ = changed.error().message();
@@ -96,9 +124,21 @@ class MovieStream final : public TextureStream {
       return false;
     }
     if (texture_->showingFallback()) return false;  // no frame yet: never a frame early
+    if ((retrying_ || !cause_.empty()) && frame) {  // the changed file's first frame
+      if (!broken_.empty()) {
+        log::info(kLogStreams, "movie '{}': {} plays again", media_.name, media_.file);
+      } else {
+        log::info(kLogStreams, "movie '{}': {} {}; playing the new content", media_.name, media_.file, cause_);
+      }
+      broken_.clear();
+      cause_.clear();
+      retrying_ = false;
+    }
     texture_->publish(textures);
     return true;
   }
+
+  [[nodiscard]] bool degraded() const override { return !broken_.empty(); }
 
   void alignTo(Nanos origin, std::chrono::milliseconds patience) override {
     if (origin_ == origin && patience_ == patience) return;
@@ -118,6 +158,9 @@ class MovieStream final : public TextureStream {
 
   [[nodiscard]] std::string describe() const override {
     if (!failure_.empty()) return fmt::format("movie {}: {}", media_.file.filename(), failure_);
+    if (!broken_.empty()) {
+      return fmt::format("movie {}: {}; waiting for a good file", media_.file.filename(), broken_);
+    }
     const media::MovieInfo info = player_->info();
     const media::MoviePlayerStats stats = player_->stats();
     return fmt::format("movie {}: frame {} of {}, {} loops{}", media_.file.filename(), player_->currentFrame(),
@@ -158,6 +201,111 @@ class MovieStream final : public TextureStream {
                toSeconds(showTime), index);
   }
 
+  /// Watches the file's folder; where that cannot be done, the file is looked at on a back-off.
+  void watchFile(Nanos showTime) {
+    auto watch = FileWatch::open(media_.file);
+    if (watch) {
+      watch_ = std::move(*watch);
+      return;
+    }
+    watch_.reset();
+    if (!watchFailed_) {
+      watchFailed_ = true;
+      log::warn(kLogStreams, "movie '{}': {}; a change to the file is seen within {} s instead of at once", media_.name,
+                watch.error().describe(), toSeconds(kLookMost));
+    }
+    nextLook_ = showTime + lookEvery_;
+    lookEvery_ = std::min(lookEvery_ * 2, kLookMost);
+  }
+
+  /// Acts on a change to the file: at once when it settled (closed after writing, moved, created,
+  /// deleted), after kWriteQuiet when it is being written. Costs one non-blocking read a frame.
+  void lookAtFile(Nanos showTime) {
+    bool look = false;
+    if (watch_) {
+      switch (watch_->take()) {
+        case FileChange::kNone: break;
+        case FileChange::kWriting: writingSince_ = showTime; break;
+        case FileChange::kSettled: look = true; break;
+        case FileChange::kWatchLost:
+          look = true;
+          watchFile(showTime);  // the folder went away: watched again, or looked at on the back-off
+          break;
+      }
+    } else if (showTime >= nextLook_) {
+      look = true;
+      watchFile(showTime);
+    }
+    if (writingSince_ && showTime - *writingSince_ >= kWriteQuiet) look = true;
+    if (!look) return;
+    writingSince_.reset();
+    const std::optional<FileIdentity> now = identify(media_.file);
+    if (now == tried_) return;  // unchanged since it was last loaded (or found gone)
+    if (!now) {
+      player_->unload();  // what plays is no longer the file the manifest names
+      cause_ = changeSince(now);
+      tried_.reset();
+      fileBroken("");
+      return;
+    }
+    startPlaying(changeSince(now));
+  }
+
+  /// Loads the file as it is now; `cause` says what happened to it, for the log ("" at start).
+  void startPlaying(std::string cause) {
+    cause_ = std::move(cause);
+    tried_ = identify(media_.file);
+    aligned_ = false;
+    if (!tried_ || tried_->size == 0) {
+      player_->unload();
+      fileBroken("");
+      return;
+    }
+    if (auto r = player_->load(media_.file); !r) {
+      fileBroken(fmt::format("cannot play: {}", r.error().message()));
+      return;
+    }
+    player_->setRepeat(media_.loop);
+    player_->play();
+    retrying_ = !broken_.empty();
+  }
+
+  /// What happened to the file since it was last loaded: deleted, emptied, replaced (another
+  /// inode under the name) or written over in place.
+  [[nodiscard]] std::string changeSince(const std::optional<FileIdentity>& now) const {
+    if (!now) return tried_ ? "was deleted" : "is missing";
+    if (!tried_) return "is back";
+    if (now->size == 0) return "was emptied";
+    if (now->device != tried_->device || now->inode != tried_->inode) return "was replaced";
+    return fmt::format("was written over ({} bytes, {} before)", now->size, tried_->size);
+  }
+
+  /// The file is gone or cannot play: the fallback shows and the stream is degraded until the
+  /// file changes. Said once (what happened and why), however often a changed file fails again.
+  void fileBroken(const std::string& why) {
+    retrying_ = false;
+    std::string text = cause_;
+    cause_.clear();
+    if (text.empty()) {
+      const std::optional<FileIdentity> now = identify(media_.file);
+      if (now != tried_) {
+        text = changeSince(now);  // changed under the decoder before its folder's event came
+      } else if (!now) {
+        text = "is missing";
+      } else if (now->size == 0) {
+        text = "is empty";
+      }
+    }
+    if (!why.empty()) text += (text.empty() ? "" : " and ") + why;
+    if (!broken_.empty()) {
+      log::debug(kLogStreams, "movie '{}': {} {}", media_.name, media_.file, text);
+      return;
+    }
+    broken_ = text;
+    log::error(kLogStreams, "movie '{}': {} {}; its textures show their fallback until a good file is there",
+               media_.name, media_.file, text);
+  }
+
   MediaSpec media_;
   std::unique_ptr<media::MoviePlayer> player_;
   std::unique_ptr<render::StreamTexture> texture_;
@@ -169,8 +317,17 @@ class MovieStream final : public TextureStream {
   std::int64_t leaderFrame_ = -1;          // frame-locked follower: the leader's movie frame in the coming frame
   LeaderFrameResult leaderResult_ = LeaderFrameResult::kNone;
   bool started_ = false;
-  bool reportedFailure_ = false;
-  std::string failure_;
+  std::string failure_;  // the texture cannot be made or filled: for good
+  // The file and what became of it:
+  std::optional<FileWatch> watch_;
+  bool watchFailed_ = false;           // said once that the folder cannot be watched
+  Nanos nextLook_{0};                  // no watch: when the file is looked at next
+  Nanos lookEvery_ = kLookFirst;       // ... and the back-off after that
+  std::optional<Nanos> writingSince_;  // the file is being written: look once it is quiet
+  std::optional<FileIdentity> tried_;  // the file as it was last loaded (none: it was not there)
+  std::string cause_;                  // what happened to the file before the load under way (for the log)
+  std::string broken_;                 // why the fallback shows (the stream is degraded); "" while it plays
+  bool retrying_ = false;              // broken, and a changed file is loading: its first frame ends it
 };
 
 }  // namespace
@@ -184,6 +341,7 @@ Result<std::unique_ptr<TextureStream>> makeMovieStream(const MediaSpec& media, c
   media::MoviePlayerOptions options;
   options.name = fmt::format("movie '{}'", media.name);
   options.audio = media.audio;
+  options.logFailures = false;  // the stream says what failed and what shows instead, once
   auto player = media::MoviePlayer::create(options);
   if (!player) return std::unexpected(player.error());
   return std::make_unique<MovieStream>(media, std::move(*player), clock.isManual());

@@ -66,7 +66,8 @@ constexpr std::string_view kDeviceStateHelp =
     "The device's state as a number: 0 absent, 1 opening, 2 live, 3 lost, 4 reopening, 5 idle (a camera no "
     "texture shows), -1 another.";
 constexpr std::string_view kStreamStateHelp =
-    "The stream's state as a number: 0 absent, 1 waiting, 2 playing, 3 lost, -1 another.";
+    "The stream's state as a number: 0 absent, 1 waiting, 2 playing, 3 lost, 4 degraded (its content is broken), "
+    "-1 another.";
 
 int deviceStateNumber(std::string_view state) {
   constexpr std::array<std::string_view, 6> kNames{"absent", "opening", "live", "lost", "reopening", "idle"};
@@ -75,7 +76,7 @@ int deviceStateNumber(std::string_view state) {
 }
 
 int streamStateNumber(std::string_view state) {
-  constexpr std::array<std::string_view, 4> kNames{"absent", "waiting", "playing", "lost"};
+  constexpr std::array<std::string_view, 5> kNames{"absent", "waiting", "playing", "lost", "degraded"};
   const auto it = std::find(kNames.begin(), kNames.end(), state);
   return it == kNames.end() ? -1 : static_cast<int>(it - kNames.begin());
 }

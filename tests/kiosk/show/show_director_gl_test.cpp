@@ -17,6 +17,7 @@
 
 #include <atomic>
 #include <fstream>
+#include <functional>
 #include <thread>
 
 #include "kiosk/loop/frame_loop.h"
@@ -27,6 +28,7 @@
 #include "kiosk/show/show_director.h"
 #include "kiosk/show/show_loader.h"
 #include "kiosk/status/status_board.h"
+#include "kiosk/status/status_report.h"
 #include "media/movie_probe.h"
 #include "render/output.h"
 #include "render/renderer.h"
@@ -199,6 +201,62 @@ entry = "default"
   const StatusSnapshot s = h.board().snapshot(WallTime{});
   EXPECT_EQ(s.reloadFailures, 1);
   EXPECT_NE(s.lastReload.find("failed"), std::string::npos) << s.lastReload;
+}
+
+// Makes sure a reload of a manifest that is empty, cut short in the middle of a write, not
+// UTF-8, or deleted keeps the old show playing (no black frame, the same item) and makes
+// /health "degraded" with the reason, and that the next good manifest clears it.
+// Example failure: an empty file read as a show with no entry, which puts the built-in default
+// show in place of the installation's.
+TEST(ShowDirector, AReloadOfABrokenManifestKeepsTheOldShow) {
+  Harness h("reload-broken");
+  OPEN_OR_SKIP(h);
+  const std::string good = R"(
+[show]
+name = "A"
+entry = "default"
+
+[[kiosk.playlist]]
+name = "the cube"
+entry = "default"
+)";
+  ASSERT_TRUE(h.install(good));
+  h.run(10);
+  ASSERT_EQ(h.item(), "the cube");
+  const auto manifest = h.dir() / "show.toml";
+  struct Case {
+    const char* name;
+    std::function<void()> damage;
+    const char* reason;  // in the failure the status shows
+  };
+  const std::vector<Case> cases{
+      {"empty", [&] { std::ofstream(manifest, std::ios::trunc).close(); }, "empty"},
+      {"white space only", [&] { std::ofstream(manifest, std::ios::trunc) << "\n  \n"; }, "empty"},
+      {"cut short mid-write", [&] { std::ofstream(manifest, std::ios::trunc) << good.substr(0, 25); }, "TOML"},
+      {"invalid UTF-8", [&] { std::ofstream(manifest, std::ios::trunc) << "[show]\nname = \"\xff\xfe\"\n"; }, "UTF-8"},
+      {"deleted", [&] { std::filesystem::remove(manifest); }, "show.toml"},
+  };
+  int failed = 0;
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    c.damage();
+    h.director().requestReload();
+    ++failed;
+    ASSERT_TRUE(h.runUntil([&] { return h.director().reloadsFailed() == failed; }));
+    h.run(5);
+    EXPECT_EQ(h.item(), "the cube");
+    EXPECT_EQ(h.recorder().blackFrames(), 0u) << "the old show plays on";
+    const StatusSnapshot s = h.board().snapshot(WallTime{});
+    EXPECT_EQ(s.show.name, "A");
+    EXPECT_EQ(overallState(s), "degraded");
+    EXPECT_NE(s.lastReload.find(c.reason), std::string::npos) << s.lastReload;
+  }
+  h.write(good);
+  h.director().requestReload();
+  ASSERT_TRUE(h.runUntil([&] { return h.director().reloadsApplied() == 1; }));
+  h.run(2);
+  EXPECT_EQ(overallState(h.board().snapshot(WallTime{})), "ok");
+  EXPECT_EQ(h.recorder().blackFrames(), 0u);
 }
 
 TEST(ShowDirector, DialsTurnTheShowThroughTheirBindings) {

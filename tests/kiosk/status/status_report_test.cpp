@@ -237,6 +237,12 @@ TEST(StatusMetrics, StateIsAValueNotALabel) {
   EXPECT_EQ(test::metric(ok, "basalt_state{state=\"degraded\"}"), 0.0);
   EXPECT_EQ(test::metric(ok, "basalt_device_state{device=\"knob \\\"2\\\"\"}"), 2.0);
   EXPECT_EQ(test::metric(ok, "basalt_stream_state{stream=\"live\"}"), 2.0);
+  // A movie whose file is broken: its own number, and the node is degraded.
+  s.streams[0].state = "degraded";
+  const std::string broken = metricsText(s, {});
+  EXPECT_EQ(test::metric(broken, "basalt_stream_state{stream=\"live\"}"), 4.0) << broken;
+  EXPECT_EQ(test::metric(broken, "basalt_state{state=\"degraded\"}"), 1.0);
+  s.streams[0].state = "playing";
   const auto series = [](const std::string& text) {
     std::vector<std::string> names;
     std::istringstream lines(text);
