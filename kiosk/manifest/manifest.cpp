@@ -405,6 +405,9 @@ std::optional<TextProblem> invalidUtf8(std::string_view text) {
 /// - a quote starts a string only where TOML allows one (a key at the start of a line, after
 ///   `[`, `{`, `.` in a key, `,` or `=`); elsewhere (`8'...`, `'a''b'`) toml++ reads it as part
 ///   of a token or refuses it, and what follows is outside any string;
+/// - a value that is not a string, array or inline table (a number, date, boolean, inf, nan, or
+///   a bad token) is read by toml++ up to a value terminator (whitespace, `,`, `]`, `}`, `#`),
+///   so a quote, `=`, `[` or `{` inside it (`8='...'`) opens nothing;
 /// - inside a multi-line basic string, not right after a backslash, nor first after a
 ///   line-ending backslash (toml++ tests those for whitespace).
 std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
@@ -416,6 +419,7 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
   std::vector<Open> open;  // brackets and braces open in code, innermost last
   bool keyContext = true;  // a key may come next (rather than a value)
   char previous = '\n';    // the last character of code that is not a space, tab or comment
+  bool bareValue = false;  // inside a value toml++ reads up to a value terminator
   const auto spot = [&](std::size_t at) {
     int column = 1;
     for (std::size_t i = lineStart; i < at; ++i) column += (static_cast<unsigned char>(text[i]) & 0xC0) != 0x80;
@@ -444,6 +448,7 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
     if (c == '\n') {
       ++line;
       lineStart = i + 1;
+      bareValue = false;
       if (in != In::kMultiBasic && in != In::kMultiLiteral) {
         in = In::kCode;
         // A new line at the top level starts a key; inside an array, values go on.
@@ -459,14 +464,23 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
     switch (in) {
       case In::kCode:
         if (high) return spot(i);
-        if (c == ' ' || c == '\t' || c == '\r') break;
+        if (c == ' ' || c == '\t' || c == '\r') {
+          bareValue = false;
+          break;
+        }
+        if (bareValue && c != ',' && c != ']' && c != '}' && c != '#') {
+          previous = c;  // still the bare value
+          break;
+        }
+        bareValue = false;
         if (c == '#') {
           in = In::kComment;
           break;
         }
         if (c == '"' || c == '\'') {
           if (!stringMayStart()) {
-            previous = c;  // part of a bad token: what follows is code
+            previous = c;             // part of a bad token: what follows is code
+            bareValue = !keyContext;  // and a bad value goes on up to a value terminator
             break;
           }
           const bool multi = quotes(i, c) >= 3;
@@ -490,6 +504,8 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
           keyContext = false;
         } else if (c == ',') {
           keyContext = !open.empty() && open.back() == Open::kInlineTable;
+        } else if (!keyContext) {
+          bareValue = true;  // a number, date, boolean, inf or nan starts
         }
         previous = c;
         break;
