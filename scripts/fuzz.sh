@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Builds Basalt's libFuzzer targets with clang-19 (ASan + UBSan) and runs each for a bounded time.
+# Builds Basalt's libFuzzer targets with clang-19 (ASan + UBSan, every Basalt library with
+# libFuzzer's coverage instrumentation) and runs each for a bounded time.
 #   scripts/fuzz.sh [SECONDS_PER_TARGET]    (default 60; CI uses a shorter budget)
+# Before fuzzing, fuzz_instrumented.* checks that every library a target links is instrumented.
 # New crashes are written to build-fuzz/crashes/<target>/; add them to tests/fuzz/corpus/<target>/
 # once fixed, so that the gcc replay test keeps them fixed.
 set -euo pipefail
@@ -15,6 +17,13 @@ if [ ${#fuzzers[@]} -eq 0 ]; then
   exit 0
 fi
 cmake --build "$build" --target "${fuzzers[@]}"
+checks=$(printf '%s\n' "${fuzzers[@]}" | sed 's/_fuzzer$//' | paste -sd'|')
+if ! ctest --test-dir "$build" -R "^fuzz_instrumented\\.($checks)\$" --output-on-failure >"$build/instrumented.log" 2>&1; then
+  cat "$build/instrumented.log"
+  echo "fuzz: a library under test lacks the coverage instrumentation (fuzz_instrumented.*)"
+  exit 1
+fi
+echo "== fuzz: every Basalt library the targets link is instrumented ($(grep -c ' Passed ' "$build/instrumented.log") checks)"
 status=0
 for f in "${fuzzers[@]}"; do
   name=${f%_fuzzer}
