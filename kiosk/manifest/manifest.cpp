@@ -12,6 +12,7 @@
 #include <netinet/in.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -408,6 +409,9 @@ std::optional<TextProblem> invalidUtf8(std::string_view text) {
 /// - a value that is not a string, array or inline table (a number, date, boolean, inf, nan, or
 ///   a bad token) is read by toml++ up to a value terminator (whitespace, `,`, `]`, `}`, `#`),
 ///   so a quote, `=`, `[` or `{` inside it (`8='...'`) opens nothing;
+/// Also, with a `what` of its own: a table header whose `[` is not followed by a key, a quote or
+/// `]` (`[#`, `[=`, `[` at the end of a line): toml++ 3.3 reads a key there without checking, and
+/// assumes (`__builtin_assume` under clang, undefined behaviour when false) that one starts.
 /// - inside a multi-line basic string, not right after a backslash, nor first after a
 ///   line-ending backslash (toml++ tests those for whitespace).
 std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
@@ -492,6 +496,18 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
         if (c == '[') {
           // `[` at the start of a line opens a table header, and `[[` an array-of-tables header.
           const bool header = keyContext && (open.empty() || (open.back() == Open::kHeader && previous == '['));
+          if (header) {
+            std::size_t next = i + 1;
+            while (next < text.size() && (text[next] == ' ' || text[next] == '\t')) ++next;
+            const char k = next < text.size() ? text[next] : ']';
+            const bool keyStarts = std::isalnum(static_cast<unsigned char>(k)) != 0 || k == '_' || k == '-' ||
+                                   k == '"' || k == '\'' || k == ']' || (k == '[' && next == i + 1);
+            if (!keyStarts) {
+              TextProblem problem = spot(next);
+              problem.what = "a table header without a key after its '['";
+              return problem;
+            }
+          }
           open.push_back(header ? Open::kHeader : Open::kArray);
           keyContext = open.back() == Open::kHeader;
         } else if (c == '{') {
@@ -654,10 +670,14 @@ class Reader {
       return std::nullopt;
     }
     if (const auto bad = misplacedNonAscii(text)) {
-      diags_.error(shown_, bad->line,
-                   fmt::format("not valid TOML: a non-ASCII character at column {} outside quotes or a comment (or "
-                               "right after a backslash in a \"\"\" string); put text in quotes",
-                               bad->column));
+      if (bad->what.starts_with("a table header")) {
+        diags_.error(shown_, bad->line, fmt::format("not valid TOML: {} (column {})", bad->what, bad->column));
+      } else {
+        diags_.error(shown_, bad->line,
+                     fmt::format("not valid TOML: a non-ASCII character at column {} outside quotes or a comment (or "
+                                 "right after a backslash in a \"\"\" string); put text in quotes",
+                                 bad->column));
+      }
       return std::nullopt;
     }
     toml::parse_result parsed = toml::parse(text, file_.string());

@@ -256,6 +256,23 @@ TEST(ManifestErrors, EqualsInsideABareValueStartsNoString) {
   }
 }
 
+// Found by replaying the fuzzed corpus with toml++'s assertions on: after a table header's `[`,
+// toml++ reads a key without checking that one starts, assuming it (undefined behaviour under
+// clang when it does not). Basalt reports such a header itself.
+TEST(ManifestErrors, TableHeaderWithoutAKeyIsReportedBeforeToml) {
+  ShowFolder f("toml-header-without-key");
+  for (const std::string header : {"[#", "[=", "[ ,x]", "[[.", "[\n", "[\r\n", "[ "}) {
+    const auto r = f.read("[show]\nname = 'x'\n" + header + "\n");
+    EXPECT_FALSE(r.manifest) << header;
+    EXPECT_TRUE(hasError(r, 3, "a table header without a key after its '['")) << header << ": " << r.text;
+  }
+  // Keys, quoted keys, arrays of tables and `[]` (toml++'s own error) are not this.
+  for (const std::string header : {"[ status ]", "['show']", "[[a]]", "[]", "[ -x]"}) {
+    const auto r = f.read("[show]\nname = 'x'\n" + header + "\n");
+    EXPECT_FALSE(hasError(r, 3, "a table header without a key")) << header << ": " << r.text;
+  }
+}
+
 // Strings cut off by the end of the file right after a multibyte character: a clear TOML
 // error from toml++ (the text is valid UTF-8 and the character is inside the string).
 TEST(ManifestErrors, UnterminatedStringsEndingInMultibyteAreTomlErrors) {
