@@ -11,8 +11,11 @@ set(BASALT_SANITIZE "" CACHE STRING
 # (-fsanitize=fuzzer-no-link), so that the fuzzer's feedback sees the parsers' branches and not
 # only those of the target's own file. Third-party libraries are linked as Debian ships them.
 option(BASALT_FUZZ "Build libFuzzer targets (clang only) instead of the corpus replay tests" OFF)
-if(BASALT_FUZZ AND NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
-  message(FATAL_ERROR "BASALT_FUZZ needs clang (scripts/fuzz.sh uses clang-19)")
+# The fuzz coverage build (scripts/fuzz-coverage.sh, clang-19): source-based line coverage
+# (-fprofile-instr-generate -fcoverage-mapping) of every Basalt target, read with llvm-cov.
+option(BASALT_COVERAGE "Build with clang's source-based coverage (clang only)" OFF)
+if((BASALT_FUZZ OR BASALT_COVERAGE) AND NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  message(FATAL_ERROR "BASALT_FUZZ and BASALT_COVERAGE need clang (scripts/fuzz.sh uses clang-19)")
 endif()
 
 find_program(BASALT_CCACHE ccache)
@@ -38,6 +41,11 @@ if(BASALT_SANITIZE)
     add_link_options(-fsanitize=${_san})
   endforeach()
   add_compile_options(-fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+endif()
+
+if(BASALT_COVERAGE)
+  add_compile_options(-fprofile-instr-generate -fcoverage-mapping)
+  add_link_options(-fprofile-instr-generate)
 endif()
 
 # Applies Basalt's warnings and include layout to a target of ours (never to third-party code).
