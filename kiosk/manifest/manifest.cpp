@@ -409,9 +409,10 @@ std::optional<TextProblem> invalidUtf8(std::string_view text) {
 /// - a value that is not a string, array or inline table (a number, date, boolean, inf, nan, or
 ///   a bad token) is read by toml++ up to a value terminator (whitespace, `,`, `]`, `}`, `#`),
 ///   so a quote, `=`, `[` or `{` inside it (`8='...'`) opens nothing;
-/// Also, with a `what` of its own: a table header whose `[` is not followed by a key, a quote or
-/// `]` (`[#`, `[=`, `[` at the end of a line): toml++ 3.3 reads a key there without checking, and
-/// assumes (`__builtin_assume` under clang, undefined behaviour when false) that one starts.
+/// Also, with a `what` of its own, two places where toml++ 3.3 reads on without checking and
+/// assumes (`__builtin_assume` under clang, undefined behaviour when false) what it expects: a
+/// table header whose `[` is not followed by a key, a quote or `]` (`[#`, `[=`, `[[[`, `[` at the
+/// end of a line), and a `}` inside an array (toml++ reads it as the start of a value).
 /// - inside a multi-line basic string, not right after a backslash, nor first after a
 ///   line-ending backslash (toml++ tests those for whitespace).
 std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
@@ -501,7 +502,7 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
             while (next < text.size() && (text[next] == ' ' || text[next] == '\t')) ++next;
             const char k = next < text.size() ? text[next] : ']';
             const bool keyStarts = std::isalnum(static_cast<unsigned char>(k)) != 0 || k == '_' || k == '-' ||
-                                   k == '"' || k == '\'' || k == ']' || (k == '[' && next == i + 1);
+                                   k == '"' || k == '\'' || k == ']' || (k == '[' && next == i + 1 && open.empty());
             if (!keyStarts) {
               TextProblem problem = spot(next);
               problem.what = "a table header without a key after its '['";
@@ -514,6 +515,11 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
           open.push_back(Open::kInlineTable);
           keyContext = true;
         } else if (c == ']' || c == '}') {
+          if (c == '}' && !open.empty() && open.back() == Open::kArray) {
+            TextProblem problem = spot(i);
+            problem.what = "an array closed by '}'";
+            return problem;
+          }
           if (!open.empty()) open.pop_back();
           keyContext = false;
         } else if (c == '=') {
@@ -670,7 +676,7 @@ class Reader {
       return std::nullopt;
     }
     if (const auto bad = misplacedNonAscii(text)) {
-      if (bad->what.starts_with("a table header")) {
+      if (!bad->what.starts_with("a non-ASCII")) {
         diags_.error(shown_, bad->line, fmt::format("not valid TOML: {} (column {})", bad->what, bad->column));
       } else {
         diags_.error(shown_, bad->line,

@@ -261,7 +261,7 @@ TEST(ManifestErrors, EqualsInsideABareValueStartsNoString) {
 // clang when it does not). Basalt reports such a header itself.
 TEST(ManifestErrors, TableHeaderWithoutAKeyIsReportedBeforeToml) {
   ShowFolder f("toml-header-without-key");
-  for (const std::string header : {"[#", "[=", "[ ,x]", "[[.", "[\n", "[\r\n", "[ "}) {
+  for (const std::string header : {"[#", "[=", "[ ,x]", "[[.", "[[[", "[\n", "[\r\n", "[ "}) {
     const auto r = f.read("[show]\nname = 'x'\n" + header + "\n");
     EXPECT_FALSE(r.manifest) << header;
     EXPECT_TRUE(hasError(r, 3, "a table header without a key after its '['")) << header << ": " << r.text;
@@ -270,6 +270,21 @@ TEST(ManifestErrors, TableHeaderWithoutAKeyIsReportedBeforeToml) {
   for (const std::string header : {"[ status ]", "['show']", "[[a]]", "[]", "[ -x]"}) {
     const auto r = f.read("[show]\nname = 'x'\n" + header + "\n");
     EXPECT_FALSE(hasError(r, 3, "a table header without a key")) << header << ": " << r.text;
+  }
+}
+
+// Also found by replaying the fuzzed corpus with assertions on: toml++ takes a `}` inside an
+// array for the start of a value, which it assumes cannot be a value terminator.
+TEST(ManifestErrors, ArrayClosedByABraceIsReportedBeforeToml) {
+  ShowFolder f("toml-array-brace");
+  for (const std::string value : {"[}", "[ 1, }", "[ { at = 1 }, }, ]", "[ [ 1 } ]"}) {
+    const auto r = f.read("[show]\nname = 'x'\n[dial]\nscript = " + value + "\n");
+    EXPECT_FALSE(r.manifest) << value;
+    EXPECT_TRUE(hasError(r, 4, "an array closed by '}'")) << value << ": " << r.text;
+  }
+  const auto inline_tables = f.read("[show]\nname = 'x'\n[dial]\nscript = [ {a = [1]}, { b = 2 } ]\n");
+  for (const Diagnostic& d : inline_tables.diagnostics.items()) {
+    EXPECT_EQ(d.message.find("closed by"), std::string::npos) << inline_tables.text;
   }
 }
 
