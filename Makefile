@@ -12,7 +12,10 @@
 #   make lint       clang-format and clang-tidy, as CI checks them
 #   make format     reformat the sources with clang-format
 #   make sanitize   build with AddressSanitizer + UBSan and run the unit, contract, render, media, script and fuzz tiers (the two day-long soaks run in make test only)
-#   make fuzz       build the libFuzzer targets with clang-19 and run each for FUZZ_SECONDS
+#   make fuzz       build the libFuzzer targets with clang-19 and run each for FUZZ_SECONDS; prints
+#                   each target's final cov:/ft: figures
+#   make fuzz-coverage  line coverage of each fuzz target's parser files over its corpus (the
+#                   seeds and what make fuzz added), with clang-19's source-based coverage
 #   make vlab       build and run the virtual-lab tests (qemu with real kernel drivers) alone
 #   make vlab-shell an interactive shell inside the virtual lab, with the build tree
 
@@ -23,7 +26,7 @@ CMAKE_ARGS ?=
 FUZZ_SECONDS ?= 60
 
 .PHONY: all setup setup-test configure configure-run build build-run run install package test bench lint format \
-	sanitize fuzz vlab vlab-shell clean
+	sanitize fuzz fuzz-coverage vlab vlab-shell clean
 
 all: build
 
@@ -84,6 +87,9 @@ sanitize: setup-test
 fuzz: setup-test
 	@scripts/fuzz.sh $(FUZZ_SECONDS)
 
+fuzz-coverage: setup-test
+	@scripts/fuzz-coverage.sh
+
 vlab: build
 	@scripts/run-tests.sh $(BUILD) -L vlab
 
@@ -91,4 +97,4 @@ vlab-shell: setup-test
 	@tools/vlab/shell $(if $(wildcard $(BUILD)),--build $(BUILD))
 
 clean:
-	rm -rf $(BUILD) $(BUILD)-sanitize build-fuzz out
+	rm -rf $(BUILD) $(BUILD)-sanitize build-fuzz build-fuzz-cov out

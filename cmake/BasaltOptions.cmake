@@ -6,6 +6,17 @@ option(BASALT_WERROR "Treat compiler warnings as errors" OFF)
 option(BASALT_BENCH "Build the benchmarks (tests/bench)" ON)
 set(BASALT_SANITIZE "" CACHE STRING
     "Sanitizers to build with: a comma-separated subset of address,undefined,thread")
+# The fuzz build (scripts/fuzz.sh, clang-19): libFuzzer targets instead of the corpus replay tests,
+# and every Basalt library compiled with libFuzzer's coverage instrumentation
+# (-fsanitize=fuzzer-no-link), so that the fuzzer's feedback sees the parsers' branches and not
+# only those of the target's own file. Third-party libraries are linked as Debian ships them.
+option(BASALT_FUZZ "Build libFuzzer targets (clang only) instead of the corpus replay tests" OFF)
+# The fuzz coverage build (scripts/fuzz-coverage.sh, clang-19): source-based line coverage
+# (-fprofile-instr-generate -fcoverage-mapping) of every Basalt target, read with llvm-cov.
+option(BASALT_COVERAGE "Build with clang's source-based coverage (clang only)" OFF)
+if((BASALT_FUZZ OR BASALT_COVERAGE) AND NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  message(FATAL_ERROR "BASALT_FUZZ and BASALT_COVERAGE need clang (scripts/fuzz.sh uses clang-19)")
+endif()
 
 find_program(BASALT_CCACHE ccache)
 if(BASALT_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
@@ -32,6 +43,11 @@ if(BASALT_SANITIZE)
   add_compile_options(-fno-omit-frame-pointer -fno-sanitize-recover=undefined)
 endif()
 
+if(BASALT_COVERAGE)
+  add_compile_options(-fprofile-instr-generate -fcoverage-mapping)
+  add_link_options(-fprofile-instr-generate)
+endif()
+
 # Applies Basalt's warnings and include layout to a target of ours (never to third-party code).
 function(basalt_target_defaults target)
   target_compile_options(${target} PRIVATE ${BASALT_WARNINGS})
@@ -46,4 +62,8 @@ function(basalt_library name)
   target_link_libraries(basalt_${name} PUBLIC ${ARG_PUBLIC} PRIVATE ${ARG_PRIVATE})
   set_target_properties(basalt_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   basalt_target_defaults(basalt_${name})
+  if(BASALT_FUZZ)
+    # Coverage feedback only: the fuzz target's link (-fsanitize=fuzzer) brings libFuzzer itself.
+    target_compile_options(basalt_${name} PRIVATE -fsanitize=fuzzer-no-link)
+  endif()
 endfunction()

@@ -12,6 +12,7 @@
 #include <netinet/in.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -405,6 +406,13 @@ std::optional<TextProblem> invalidUtf8(std::string_view text) {
 /// - a quote starts a string only where TOML allows one (a key at the start of a line, after
 ///   `[`, `{`, `.` in a key, `,` or `=`); elsewhere (`8'...`, `'a''b'`) toml++ reads it as part
 ///   of a token or refuses it, and what follows is outside any string;
+/// - a value that is not a string, array or inline table (a number, date, boolean, inf, nan, or
+///   a bad token) is read by toml++ up to a value terminator (whitespace, `,`, `]`, `}`, `#`),
+///   so a quote, `=`, `[` or `{` inside it (`8='...'`) opens nothing;
+/// Also, with a `what` of its own, two places where toml++ 3.3 reads on without checking and
+/// assumes (`__builtin_assume` under clang, undefined behaviour when false) what it expects: a
+/// table header whose `[` is not followed by a key, a quote or `]` (`[#`, `[=`, `[[[`, `[` at the
+/// end of a line), and a `}` inside an array (toml++ reads it as the start of a value).
 /// - inside a multi-line basic string, not right after a backslash, nor first after a
 ///   line-ending backslash (toml++ tests those for whitespace).
 std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
@@ -416,6 +424,7 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
   std::vector<Open> open;  // brackets and braces open in code, innermost last
   bool keyContext = true;  // a key may come next (rather than a value)
   char previous = '\n';    // the last character of code that is not a space, tab or comment
+  bool bareValue = false;  // inside a value toml++ reads up to a value terminator
   const auto spot = [&](std::size_t at) {
     int column = 1;
     for (std::size_t i = lineStart; i < at; ++i) column += (static_cast<unsigned char>(text[i]) & 0xC0) != 0x80;
@@ -444,6 +453,7 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
     if (c == '\n') {
       ++line;
       lineStart = i + 1;
+      bareValue = false;
       if (in != In::kMultiBasic && in != In::kMultiLiteral) {
         in = In::kCode;
         // A new line at the top level starts a key; inside an array, values go on.
@@ -459,14 +469,23 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
     switch (in) {
       case In::kCode:
         if (high) return spot(i);
-        if (c == ' ' || c == '\t' || c == '\r') break;
+        if (c == ' ' || c == '\t' || c == '\r') {
+          bareValue = false;
+          break;
+        }
+        if (bareValue && c != ',' && c != ']' && c != '}' && c != '#') {
+          previous = c;  // still the bare value
+          break;
+        }
+        bareValue = false;
         if (c == '#') {
           in = In::kComment;
           break;
         }
         if (c == '"' || c == '\'') {
           if (!stringMayStart()) {
-            previous = c;  // part of a bad token: what follows is code
+            previous = c;             // part of a bad token: what follows is code
+            bareValue = !keyContext;  // and a bad value goes on up to a value terminator
             break;
           }
           const bool multi = quotes(i, c) >= 3;
@@ -478,18 +497,37 @@ std::optional<TextProblem> misplacedNonAscii(std::string_view text) {
         if (c == '[') {
           // `[` at the start of a line opens a table header, and `[[` an array-of-tables header.
           const bool header = keyContext && (open.empty() || (open.back() == Open::kHeader && previous == '['));
+          if (header) {
+            std::size_t next = i + 1;
+            while (next < text.size() && (text[next] == ' ' || text[next] == '\t')) ++next;
+            const char k = next < text.size() ? text[next] : ']';
+            const bool keyStarts = std::isalnum(static_cast<unsigned char>(k)) != 0 || k == '_' || k == '-' ||
+                                   k == '"' || k == '\'' || k == ']' || (k == '[' && next == i + 1 && open.empty());
+            if (!keyStarts) {
+              TextProblem problem = spot(next);
+              problem.what = "a table header without a key after its '['";
+              return problem;
+            }
+          }
           open.push_back(header ? Open::kHeader : Open::kArray);
           keyContext = open.back() == Open::kHeader;
         } else if (c == '{') {
           open.push_back(Open::kInlineTable);
           keyContext = true;
         } else if (c == ']' || c == '}') {
+          if (c == '}' && !open.empty() && open.back() == Open::kArray) {
+            TextProblem problem = spot(i);
+            problem.what = "an array closed by '}'";
+            return problem;
+          }
           if (!open.empty()) open.pop_back();
           keyContext = false;
         } else if (c == '=') {
           keyContext = false;
         } else if (c == ',') {
           keyContext = !open.empty() && open.back() == Open::kInlineTable;
+        } else if (!keyContext) {
+          bareValue = true;  // a number, date, boolean, inf or nan starts
         }
         previous = c;
         break;
@@ -638,10 +676,14 @@ class Reader {
       return std::nullopt;
     }
     if (const auto bad = misplacedNonAscii(text)) {
-      diags_.error(shown_, bad->line,
-                   fmt::format("not valid TOML: a non-ASCII character at column {} outside quotes or a comment (or "
-                               "right after a backslash in a \"\"\" string); put text in quotes",
-                               bad->column));
+      if (!bad->what.starts_with("a non-ASCII")) {
+        diags_.error(shown_, bad->line, fmt::format("not valid TOML: {} (column {})", bad->what, bad->column));
+      } else {
+        diags_.error(shown_, bad->line,
+                     fmt::format("not valid TOML: a non-ASCII character at column {} outside quotes or a comment (or "
+                                 "right after a backslash in a \"\"\" string); put text in quotes",
+                                 bad->column));
+      }
       return std::nullopt;
     }
     toml::parse_result parsed = toml::parse(text, file_.string());

@@ -95,8 +95,12 @@ class SceneParser {
     return true;
   }
 
+  /// A skipped statement leaves `out` as it was (parseFloat may have written a prefix's value).
   bool scalar(const StatementItem& item, const std::vector<std::string_view>& v, float& out) {
-    return numbers(item, v, &out, 1);
+    float value = 0;
+    if (!numbers(item, v, &value, 1)) return false;
+    out = value;
+    return true;
   }
 
   /// A colour of 0..255 integers (a value with a fraction means 0..1), clamped with a warning.

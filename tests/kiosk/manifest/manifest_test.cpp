@@ -233,6 +233,61 @@ TEST(ManifestErrors, QuoteThatStartsNoStringLeavesNonAsciiOutside) {
   EXPECT_TRUE(hasError(afterKey, 2, "non-ASCII character at column 6 outside quotes")) << afterKey.text;
 }
 
+// The fuzzing reproducer `i=8'='-i8-` then U+046F: toml++ reads a value that starts with a digit
+// (or a letter: true, inf, a date) up to whitespace, `,`, `]`, `}` or `#`, so the `=` and the
+// quotes inside it start no string, and the Cyrillic letter reached toml++'s whitespace test.
+TEST(ManifestErrors, EqualsInsideABareValueStartsNoString) {
+  ShowFolder f("toml-equals-in-value");
+  const auto r = f.read("i=8'='-i8-\xD1\xAF");
+  EXPECT_FALSE(r.manifest);
+  EXPECT_TRUE(hasError(r, 1, "non-ASCII character at column 11 outside quotes")) << r.text;
+  for (const std::string value : {"8=", "true=", "1979-05-27T07:32:00=", "inf[", "1{", "8'"}) {
+    const auto v = f.read("[show]\nfps = " + value + "'\xC3\xA9'\n");
+    EXPECT_FALSE(v.manifest) << value;
+    const std::string column = std::to_string(8 + value.size());
+    EXPECT_TRUE(hasError(v, 2, "non-ASCII character at column " + column + " outside quotes")) << value << v.text;
+  }
+  // A value terminator ends the bare value: strings after it are strings.
+  const auto arrays = f.read(
+      "[show]\nname = 'x' # 1=\xC3\xA9\n[\"status\"]\nlisten = \"127.0.0.1:0\"\n"
+      "[schedule]\nholidays = [1979-05-27,'\xC3\xA9', {a=1,b='\xC3\xA9'}]\n");
+  for (const Diagnostic& d : arrays.diagnostics.items()) {
+    EXPECT_EQ(d.message.find("outside quotes"), std::string::npos) << arrays.text;
+  }
+}
+
+// Found by replaying the fuzzed corpus with toml++'s assertions on: after a table header's `[`,
+// toml++ reads a key without checking that one starts, assuming it (undefined behaviour under
+// clang when it does not). Basalt reports such a header itself.
+TEST(ManifestErrors, TableHeaderWithoutAKeyIsReportedBeforeToml) {
+  ShowFolder f("toml-header-without-key");
+  for (const std::string header : {"[#", "[=", "[ ,x]", "[[.", "[[[", "[\n", "[\r\n", "[ "}) {
+    const auto r = f.read("[show]\nname = 'x'\n" + header + "\n");
+    EXPECT_FALSE(r.manifest) << header;
+    EXPECT_TRUE(hasError(r, 3, "a table header without a key after its '['")) << header << ": " << r.text;
+  }
+  // Keys, quoted keys, arrays of tables and `[]` (toml++'s own error) are not this.
+  for (const std::string header : {"[ status ]", "['show']", "[[a]]", "[]", "[ -x]"}) {
+    const auto r = f.read("[show]\nname = 'x'\n" + header + "\n");
+    EXPECT_FALSE(hasError(r, 3, "a table header without a key")) << header << ": " << r.text;
+  }
+}
+
+// Also found by replaying the fuzzed corpus with assertions on: toml++ takes a `}` inside an
+// array for the start of a value, which it assumes cannot be a value terminator.
+TEST(ManifestErrors, ArrayClosedByABraceIsReportedBeforeToml) {
+  ShowFolder f("toml-array-brace");
+  for (const std::string value : {"[}", "[ 1, }", "[ { at = 1 }, }, ]", "[ [ 1 } ]"}) {
+    const auto r = f.read("[show]\nname = 'x'\n[dial]\nscript = " + value + "\n");
+    EXPECT_FALSE(r.manifest) << value;
+    EXPECT_TRUE(hasError(r, 4, "an array closed by '}'")) << value << ": " << r.text;
+  }
+  const auto inline_tables = f.read("[show]\nname = 'x'\n[dial]\nscript = [ {a = [1]}, { b = 2 } ]\n");
+  for (const Diagnostic& d : inline_tables.diagnostics.items()) {
+    EXPECT_EQ(d.message.find("closed by"), std::string::npos) << inline_tables.text;
+  }
+}
+
 // Strings cut off by the end of the file right after a multibyte character: a clear TOML
 // error from toml++ (the text is valid UTF-8 and the character is inside the string).
 TEST(ManifestErrors, UnterminatedStringsEndingInMultibyteAreTomlErrors) {

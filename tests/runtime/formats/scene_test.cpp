@@ -45,6 +45,21 @@ Result<SceneDescription> parse(std::string_view text, std::vector<Diagnostic>& w
   return parseSceneText(text, name, test::quiet(), warnings);
 }
 
+// Found by fuzzing: `eyespacing[-6` then a byte that ends no number was skipped with a warning,
+// yet the -6 read before the bad byte stayed in the scene (and a negative eye spacing, which the
+// reader otherwise replaces, was written back). A skipped statement changes nothing.
+TEST(Scene, SkippedScalarLeavesTheValueAsItWas) {
+  for (const std::string statement : {"eyespacing[-6\xE0]", "eyespacing[0.5x]", "positionchange[7x]"}) {
+    std::vector<Diagnostic> warnings;
+    auto s = parse(statement + "\n", warnings);
+    ASSERT_TRUE(s) << statement;
+    EXPECT_EQ(warnings.size(), 1u) << statement << listWarnings(warnings);
+    const SceneDescription defaults;
+    EXPECT_EQ(s->eyeSpacing, defaults.eyeSpacing) << statement;
+    EXPECT_EQ(s->positionChange, defaults.positionChange) << statement;
+  }
+}
+
 TEST(Scene, EveryStatementOfTheThesis) {
   std::vector<Diagnostic> warnings;
   auto s = parse(kFullScene, warnings);

@@ -1,0 +1,1 @@
+eyespacing[-6à]
