@@ -217,6 +217,20 @@ gboolean onAutoplugContinue(GstElement*, GstPad*, GstCaps* caps, gpointer data) 
   return TRUE;
 }
 
+/// Answers the file source's allocation query at once, with "no preference", instead of letting
+/// it wait in the queue. A file source asks again whenever decodebin relinks (a reconfigure),
+/// often after its last read; the query is serialized, so it sits in the queue behind the file's
+/// data. When the demuxer has every sample before that data is pushed (push mode with the index
+/// after the media data: it seeked to the index and back), it answers EOS, the queue drops what
+/// it holds, and on this GStreamer the waiting source is never woken: it never sends EOS, and
+/// the decoder keeps its last frames for ever. A file source needs nothing from downstream's
+/// allocation answer, so failing the query costs nothing (it already fails it at start-up).
+GstPadProbeReturn refuseAllocationQuery(GstPad*, GstPadProbeInfo* info, gpointer) {
+  GstQuery* query = GST_PAD_PROBE_INFO_QUERY(info);
+  if (query != nullptr && GST_QUERY_TYPE(query) == GST_QUERY_ALLOCATION) return GST_PAD_PROBE_DROP;
+  return GST_PAD_PROBE_OK;
+}
+
 }  // namespace
 
 struct MoviePlayer::Impl {
@@ -360,6 +374,10 @@ Result<std::unique_ptr<Clip>> MoviePlayer::Impl::openClip(std::size_t entry, boo
   clip->sink = gst_bin_get_by_name(reinterpret_cast<GstBin*>(tail), "sink");
   gst_object_unref(clip->sink);  // the bin keeps it alive
   g_object_set(src, "location", clip->path.c_str(), nullptr);
+  if (GstPad* srcPad = gst_element_get_static_pad(src, "src")) {
+    gst_pad_add_probe(srcPad, GST_PAD_PROBE_TYPE_QUERY_DOWNSTREAM, refuseAllocationQuery, nullptr, nullptr);
+    gst_object_unref(srcPad);
+  }
   g_object_set(clip->sink, "sync", FALSE, "max-buffers", 2U, "drop", FALSE, "emit-signals", FALSE, "enable-last-sample",
                FALSE, nullptr);
   g_signal_connect(dec, "pad-added", G_CALLBACK(onPadAdded), clip.get());
