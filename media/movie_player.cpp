@@ -277,7 +277,8 @@ struct MoviePlayer::Impl {
   std::atomic<std::uint64_t> decoded{0};
   std::atomic<std::uint64_t> shown{0};
   std::atomic<std::uint64_t> loops{0};
-  std::atomic<std::int64_t> passNs{0};  // one pass of a looping clip on the timeline (0: not looped yet)
+  std::atomic<std::int64_t> passNs{0};         // one pass of a looping clip on the timeline (0: not looped yet)
+  std::atomic<std::int64_t> endedEarlyNs{-1};  // MovieInfo::endedEarlyAt of the loaded clip, read each frame
   std::atomic<std::uint64_t> stalls{0};
 
   // Decoder thread only:
@@ -590,11 +591,20 @@ void MoviePlayer::Impl::endOfClip() {
     clip.info.frameCount = lastIndex + 1;
   }
   clip.info.frameCountExact = true;
+  if (dropBelow == 0 && lastIndex >= 0 && clip.info.duration > Nanos{0}) {
+    // The picture ends well before the container's duration: the file lost its end. (A sound
+    // track a little longer than the picture stays under the bound.)
+    const Nanos played = clip.info.frameDuration * (lastIndex + 1);
+    const Nanos bound = std::max<Nanos>(std::chrono::seconds(1), clip.info.duration / 20);
+    if (clip.info.duration - played > bound) clip.info.endedEarlyAt = played;
+  }
   {
     std::lock_guard lock(mutex);
     if (info.path == clip.path) {
       info.frameCount = clip.info.frameCount;
       info.frameCountExact = true;
+      info.endedEarlyAt = clip.info.endedEarlyAt;
+      endedEarlyNs.store(clip.info.endedEarlyAt.count(), std::memory_order_relaxed);
     }
   }
   const Nanos nextBase = lastPts.count() >= 0 ? lastPts + clip.info.frameDuration : base;
@@ -902,6 +912,7 @@ Result<void> MoviePlayer::loadPlaylist(const std::vector<std::filesystem::path>&
     impl_->info = MovieInfo{};
     impl_->info.path = paths.front();
     impl_->ended = false;
+    impl_->endedEarlyNs.store(-1, std::memory_order_relaxed);
   }
   impl_->post({Impl::Command::Kind::kLoad, generation_, paths, 0, Nanos{0}, false});
   if (repeat_) impl_->post({Impl::Command::Kind::kRepeat, generation_, {}, 0, Nanos{0}, true});
@@ -1068,6 +1079,8 @@ void MoviePlayer::seekFrameDueAt(std::int64_t frame, Nanos due, Nanos timeline) 
 }
 
 Nanos MoviePlayer::passDuration() const { return Nanos{impl_->passNs.load(std::memory_order_relaxed)}; }
+
+Nanos MoviePlayer::endedEarlyAt() const { return Nanos{impl_->endedEarlyNs.load(std::memory_order_relaxed)}; }
 
 void MoviePlayer::seekTime(Nanos time) {
   const Nanos dur = frameDuration();

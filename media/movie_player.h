@@ -27,12 +27,16 @@ struct MovieInfo {
   std::filesystem::path path;
   std::uint32_t width = 0;
   std::uint32_t height = 0;
-  double pixelAspect = 1;                      ///< pixel width / pixel height (anamorphic files are not 1)
-  double fps = 0;                              ///< nominal frames per second (from the stream, or measured)
-  Nanos frameDuration{0};                      ///< 1/fps
-  std::int64_t frameCount = -1;                ///< estimated from the duration; exact once played through; -1 unknown
-  bool frameCountExact = false;                ///< true once the whole clip has been decoded
-  Nanos duration{-1};                          ///< -1 when the container does not say
+  double pixelAspect = 1;        ///< pixel width / pixel height (anamorphic files are not 1)
+  double fps = 0;                ///< nominal frames per second (from the stream, or measured)
+  Nanos frameDuration{0};        ///< 1/fps
+  std::int64_t frameCount = -1;  ///< estimated from the duration; exact once played through; -1 unknown
+  bool frameCountExact = false;  ///< true once the whole clip has been decoded
+  Nanos duration{-1};            ///< -1 when the container does not say
+  /// Where the picture ended when it ended well before `duration` (more than a second and more
+  /// than a twentieth of it): the file is cut short (a Matroska or MP4 with its index first
+  /// plays what is left of it). -1 while it has not.
+  Nanos endedEarlyAt{-1};
   PixelFormat format = PixelFormat::kUnknown;  ///< what frames arrive in (uploaded as is)
   Colorimetry colorimetry{};
   std::string codec;  ///< e.g. "H.264 (High Profile)"
@@ -148,6 +152,8 @@ class MoviePlayer final : public FrameSource {
   /// \brief One pass of a looping clip on the timeline (its last frame's timestamp plus a frame
   /// duration), known once it has looped; 0 before.
   [[nodiscard]] Nanos passDuration() const;
+  /// \brief MovieInfo::endedEarlyAt of the loaded clip, without copying the info (each frame).
+  [[nodiscard]] Nanos endedEarlyAt() const;
 
   [[nodiscard]] bool repeat() const { return repeat_; }
   [[nodiscard]] Transport transport() const { return transport_; }

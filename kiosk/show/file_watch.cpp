@@ -1,6 +1,7 @@
 #include "kiosk/show/file_watch.h"
 
 #include <sys/inotify.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,21 @@
 #include <fmt/format.h>
 
 namespace basalt::kiosk {
+
+std::optional<FileIdentity> identify(const std::filesystem::path& file) {
+  struct stat st{};
+  if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+  return FileIdentity{st.st_dev, st.st_ino, st.st_size,
+                      static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec};
+}
+
+std::string describeChange(const std::optional<FileIdentity>& before, const std::optional<FileIdentity>& now) {
+  if (!now) return before ? "was deleted" : "is missing";
+  if (!before) return "is back";
+  if (now->size == 0) return "was emptied";
+  if (now->device != before->device || now->inode != before->inode) return "was replaced";
+  return fmt::format("was written over ({} bytes, {} before)", now->size, before->size);
+}
 
 Result<FileWatch> FileWatch::open(const std::filesystem::path& file) {
   UniqueFd fd(::inotify_init1(IN_CLOEXEC | IN_NONBLOCK));

@@ -5,14 +5,37 @@
 /// folder, filtered by the file's name, so that a file replaced by rename (a new inode under the
 /// same name), deleted, emptied or written again is noticed without reading it every frame.
 
+#include <sys/types.h>
+
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "runtime/error.h"
 #include "runtime/unique_fd.h"
 
 namespace basalt::kiosk {
+
+/// \brief What identifies the content of a file: a rename puts another inode under the name, a
+/// write in place changes its size or modification time.
+struct FileIdentity {
+  dev_t device = 0;
+  ino_t inode = 0;
+  off_t size = 0;
+  std::int64_t modifiedNs = 0;
+  bool operator==(const FileIdentity&) const = default;
+};
+
+/// \brief The identity of the regular file at `file` now; none when it is missing or not a
+/// regular file.
+[[nodiscard]] std::optional<FileIdentity> identify(const std::filesystem::path& file);
+
+/// \brief What happened to a file between two looks, for a log line: "was deleted", "is
+/// missing", "is back", "was emptied", "was replaced" (another inode under the name) or "was
+/// written over (N bytes, M before)".
+[[nodiscard]] std::string describeChange(const std::optional<FileIdentity>& before,
+                                         const std::optional<FileIdentity>& now);
 
 /// \brief What happened to the watched file since the last take().
 enum class FileChange : std::uint8_t {

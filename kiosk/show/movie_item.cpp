@@ -5,6 +5,8 @@
 
 #include "kiosk/show/movie_item.h"
 
+#include "kiosk/show/file_watch.h"
+
 #include <algorithm>
 #include <chrono>
 #include <optional>
@@ -32,10 +34,30 @@ Error atEntry(const Error& e, const std::string& where) {
   return {e.code(), fmt::format("{}: {}", e.where(), e.message()), where};
 }
 
+/// How long a movie file that is being written must be quiet before it is looked at (a copy in
+/// place sends IN_MODIFY for every write; IN_CLOSE_WRITE ends the wait at once).
+constexpr Nanos kWriteQuiet = std::chrono::seconds(1);
+
+/// A movie played full screen as a playlist item. Its file may change while the show runs
+/// (docs/decisions/0062-content-changed-under-a-running-show.md): the file's folder is watched,
+/// and a file replaced or written over while the item plays switches to the new content at once
+/// (one info line), a file deleted or emptied ends the item with one error naming the file and
+/// what happened (the list moves on, as for any item that fails), and a changed file is loaded
+/// afresh at the item's next start.
 class MovieItem final : public ItemPlayer {
  public:
-  MovieItem(EntrySpec entry, std::string where, std::unique_ptr<media::MoviePlayer> player)
-      : entry_(std::move(entry)), where_(std::move(where)), player_(std::move(player)) {}
+  MovieItem(EntrySpec entry, std::string where, std::unique_ptr<media::MoviePlayer> player,
+            std::optional<FileIdentity> loaded)
+      : entry_(std::move(entry)), where_(std::move(where)), player_(std::move(player)), loaded_(loaded) {
+    auto watch = FileWatch::open(entry_.path);
+    if (watch) {
+      watch_ = std::move(*watch);
+    } else {
+      log::warn(kLogMovieItems,
+                "{}: movie {}: {}; a change to the file is seen at the item's next start instead of at once", where_,
+                entry_.text, watch.error().describe());
+    }
+  }
 
   void setPlayback(const Playback& playback) override { playback_ = playback; }
 
@@ -50,8 +72,18 @@ class MovieItem final : public ItemPlayer {
       if (!overlay) return std::unexpected(atEntry(overlay.error(), where_));
       overlay_ = std::move(*overlay);
     }
+    if (watch_) (void)watch_->take();  // what changed before this start is looked at now
+    writingSince_.reset();
+    if (const std::optional<FileIdentity> now = identify(entry_.path); now != loaded_) {
+      // Changed since it was loaded: play what is there now (or say what became of it).
+      const std::string what = describeChange(loaded_, now);
+      loaded_ = now;
+      player_->unload();
+      if (!now || now->size == 0) return std::unexpected(changed(what));
+      log::info(kLogMovieItems, "{}: movie {} {}; loading the new content", where_, entry_.text, what);
+    }
     if (player_->state() == media::MovieState::kEmpty) {
-      // Unloaded after a failure: try the file again (it may have been replaced).
+      // Unloaded after a failure or a change: load the file again.
       if (auto r = player_->load(entry_.path); !r) return std::unexpected(atEntry(r.error(), where_));
     }
     if (player_->state() == media::MovieState::kFailed) return std::unexpected(failure());
@@ -74,6 +106,7 @@ class MovieItem final : public ItemPlayer {
 
   Result<void> beforeDraw(const FrameContext& frame, runtime::Show& /*show*/) override {
     leaderResult_ = LeaderFrameResult::kNone;
+    if (auto r = lookAtFile(frame.time); !r) return r;
     if (endsAt_) {
       // The last frame stays up for its own duration, then the item ends.
       if (frame.time >= *endsAt_) ended_ = true;
@@ -91,6 +124,15 @@ class MovieItem final : public ItemPlayer {
     leaderResult_ = pick.outcome;
     const media::MovieState state = player_->state();
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) return std::unexpected(failure());
+    if (const Nanos early = player_->endedEarlyAt(); early >= Nanos{0}) {
+      // The file lost its end: what was left has played; it cannot loop or seek reliably.
+      const Nanos duration = player_->info().duration;
+      player_->unload();
+      return std::unexpected(
+          changed(fmt::format("is cut short (its picture ends at {:.1f} s of the {:.1f} s its "
+                              "container gives)",
+                              toSeconds(early), toSeconds(duration))));
+    }
     auto changed = texture_->update(f);
     if (!changed) {
       player_->unload();
@@ -151,6 +193,52 @@ class MovieItem final : public ItemPlayer {
     return true;
   }
 
+  /// Acts on a change to the file while the item plays: at once when it settled (closed after
+  /// writing, moved, created, deleted), after kWriteQuiet when it is being written. One
+  /// non-blocking read a frame; a stat only when the folder says something happened.
+  Result<void> lookAtFile(Nanos now) {
+    if (!watch_) return {};
+    bool look = false;
+    switch (watch_->take()) {
+      case FileChange::kNone: break;
+      case FileChange::kWriting: writingSince_ = now; break;
+      case FileChange::kSettled: look = true; break;
+      case FileChange::kWatchLost:
+        look = true;
+        if (auto again = FileWatch::open(entry_.path)) {
+          watch_ = std::move(*again);
+        } else {
+          watch_.reset();  // looked at at the next start instead
+        }
+        break;
+    }
+    if (writingSince_ && now - *writingSince_ >= kWriteQuiet) look = true;
+    if (!look) return {};
+    writingSince_.reset();
+    const std::optional<FileIdentity> identity = identify(entry_.path);
+    if (identity == loaded_) return {};
+    const std::string what = describeChange(loaded_, identity);
+    loaded_ = identity;
+    if (!identity || identity->size == 0) {
+      player_->unload();  // what plays is no longer the file the manifest names
+      return std::unexpected(changed(what));
+    }
+    // Replaced or written over: the new content from its first frame, at once (the old clip's
+    // last frame stays up until the new one's first).
+    if (auto r = player_->load(entry_.path); !r) return std::unexpected(atEntry(r.error(), where_));
+    player_->setRepeat(playback_.loop);
+    player_->play();
+    ended_ = false;
+    endsAt_.reset();
+    log::info(kLogMovieItems, "{}: movie {} {}; playing the new content", where_, entry_.text, what);
+    return {};
+  }
+
+  /// The item cannot go on because its file went away, was emptied or lost its end.
+  [[nodiscard]] Error changed(const std::string& what) const {
+    return atEntry(Error(Errc::kNotFound, fmt::format("its file {}", what), entry_.path.string()), where_);
+  }
+
   [[nodiscard]] Error failure() const {
     const auto error = player_->error();
     return atEntry(error ? *error : Error(Errc::kIo, "the movie stopped", entry_.path.string()), where_);
@@ -167,6 +255,9 @@ class MovieItem final : public ItemPlayer {
   std::optional<Nanos> endsAt_;    // show time the shown last frame ends at (not looping)
   std::int64_t leaderFrame_ = -1;  // frame-locked follower: the leader's movie frame in the coming frame
   LeaderFrameResult leaderResult_ = LeaderFrameResult::kNone;
+  std::optional<FileIdentity> loaded_;  // the file as it was last loaded (none: it was not there)
+  std::optional<FileWatch> watch_;      // its folder; none where inotify cannot watch it
+  std::optional<Nanos> writingSince_;   // the file is being written: look once it is quiet
 };
 
 }  // namespace
@@ -186,12 +277,13 @@ Result<std::unique_ptr<ItemPlayer>> makeMovieItem(const EntrySpec& entry, const 
   options.name = fmt::format("movie item {}", entry.text);
   auto player = media::MoviePlayer::create(options);
   if (!player) return std::unexpected(atEntry(player.error(), where));
+  const std::optional<FileIdentity> loaded = identify(entry.path);
   if (auto r = (*player)->load(entry.path); !r) return std::unexpected(atEntry(r.error(), where));
   auto info = (*player)->waitUntilLoaded(kLoadTimeout);
   if (!info) return std::unexpected(atEntry(info.error(), where));
   log::info(kLogMovieItems, "{}: movie {}: {}x{} at {:.3g} fps, {}", where, entry.text, info->width, info->height,
             info->fps, info->codec.empty() ? std::string("codec unknown") : info->codec);
-  return std::make_unique<MovieItem>(entry, where, std::move(*player));
+  return std::make_unique<MovieItem>(entry, where, std::move(*player), loaded);
 }
 
 }  // namespace basalt::kiosk

@@ -4,8 +4,6 @@
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/trace_video_glue.h"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <atomic>
 #include <mutex>
@@ -35,23 +33,6 @@ namespace {
 
 // ---------------------------------------------------------------------------------------------
 // Movies
-
-/// What identifies the content of a file: a rename puts another inode under the name, a write
-/// in place changes its size or modification time.
-struct FileIdentity {
-  dev_t device = 0;
-  ino_t inode = 0;
-  off_t size = 0;
-  std::int64_t modifiedNs = 0;
-  bool operator==(const FileIdentity&) const = default;
-};
-
-std::optional<FileIdentity> identify(const std::filesystem::path& file) {
-  struct stat st{};
-  if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
-  return FileIdentity{st.st_dev, st.st_ino, st.st_size,
-                      static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec};
-}
 
 /// How long a file that is being written must be quiet before it is tried (a copy in place
 /// sends IN_MODIFY for every write; IN_CLOSE_WRITE ends the wait at once).
@@ -112,6 +93,15 @@ class MovieStream final : public TextureStream {
     if (state == media::MovieState::kFailed || state == media::MovieState::kEmpty) {
       const auto error = player_->error();
       fileBroken(fmt::format("cannot play: {}", error ? error->message() : std::string("nothing is loaded")));
+      return false;
+    }
+    if (const Nanos early = player_->endedEarlyAt(); early >= Nanos{0}) {
+      // The file lost its end (Matroska, or MP4 with its index first, still open): what is left
+      // played once, but it cannot loop or seek reliably, and the copy on disk is broken.
+      const Nanos duration = player_->info().duration;
+      player_->unload();
+      fileBroken(fmt::format("is cut short (its picture ends at {:.1f} s of the {:.1f} s its container gives)",
+                             toSeconds(early), toSeconds(duration)));
       return false;
     }
     if (retrying_ && !frame) return false;  // the good file's first frame, not the old one's last
@@ -273,11 +263,7 @@ class MovieStream final : public TextureStream {
   /// What happened to the file since it was last loaded: deleted, emptied, replaced (another
   /// inode under the name) or written over in place.
   [[nodiscard]] std::string changeSince(const std::optional<FileIdentity>& now) const {
-    if (!now) return tried_ ? "was deleted" : "is missing";
-    if (!tried_) return "is back";
-    if (now->size == 0) return "was emptied";
-    if (now->device != tried_->device || now->inode != tried_->inode) return "was replaced";
-    return fmt::format("was written over ({} bytes, {} before)", now->size, tried_->size);
+    return describeChange(tried_, now);
   }
 
   /// The file is gone or cannot play: the fallback shows and the stream is degraded until the

@@ -1193,5 +1193,149 @@ TEST(ShowStreams, AMovieFileReplacedByRenameSwitchesToTheNewClipAtOnce) {
   EXPECT_EQ(h.board().snapshot(h.clock().wallNow()).streams[0].state, "playing");
 }
 
+// Makes sure a Matroska movie cut to half in place, which GStreamer still opens (its clusters
+// stand alone), plays at most what is left and then shows the texture's fallback with one line
+// saying the file is cut short, where its picture ends and how long its container says it is;
+// the stream is "degraded" until a whole file is back. The clip is 90 frames at 30 fps (3 s);
+// half of its bytes hold about 1.5 s of picture.
+// Example failures: the shorter clip plays as if nothing were wrong; its loop fails the decoder
+// with a line that does not say why ("not-linked"); a line at every loop.
+TEST(ShowStreams, AMatroskaMovieCutShortShowsTheFallbackAndSaysSo) {
+  Harness h("content-cut-mkv");
+  OPEN_OR_SKIP(h);
+  const auto example = test::sourceDir() / "configs/shows/camera-sculpture";
+  for (const char* file : {"sculpture.sce", "sculpture.obj"}) {
+    std::filesystem::copy_file(example / file, h.dir() / file, std::filesystem::copy_options::overwrite_existing);
+  }
+  ASSERT_TRUE(writeOrange(h.dir() / "camera.png"));
+  auto whole = test::makeNumberedClip(h.dir() / "whole.mkv", 90, 30, media::VideoCodec::kH264);
+  ASSERT_TRUE(whole) << whole.error().describe();
+  const auto clip = h.dir() / "clip.mkv";
+  std::filesystem::copy_file(*whole, clip, std::filesystem::copy_options::overwrite_existing);
+  std::ofstream(h.dir() / "show.toml") << R"(
+[show]
+entry = "sculpture.sce"
+[media.clip]
+kind = "movie"
+file = "clip.mkv"
+loop = true
+[textures."camera.png"]
+source = "clip"
+fallback = "camera.png"
+)";
+  ASSERT_TRUE(h.install(h.dir() / "show.toml"));
+  const LoadedTexture* t = h.texture("camera.png");
+  ASSERT_NE(t, nullptr);
+  ASSERT_NE(t->stream, nullptr) << t->streamState;
+  h.run(15);
+  ASSERT_TRUE(t->live) << t->stream->describe();
+  LogCapture logs;
+  cutTo(clip, std::filesystem::file_size(clip) / 2);
+  ASSERT_TRUE(runUntil(h, [&] { return t->stream->degraded(); }, 90)) << t->stream->describe();
+  h.run(20);
+  EXPECT_FALSE(t->live) << t->stream->describe();
+  EXPECT_GT(orangePixels(h.lastFrame()), 50u) << "the fallback shows: " << t->stream->describe();
+  const auto said = logs.problems("clip.mkv");
+  ASSERT_EQ(said.size(), 1u) << "one line; got " << said.size() << (said.empty() ? "" : ": " + said.front());
+  EXPECT_NE(said[0].find("is cut short"), std::string::npos) << said[0];
+  EXPECT_NE(said[0].find("of the 3.0 s its container gives"), std::string::npos) << said[0];
+  const StatusSnapshot status = h.board().snapshot(h.clock().wallNow());
+  ASSERT_EQ(status.streams.size(), 1u);
+  EXPECT_EQ(status.streams[0].state, "degraded") << status.streams[0].message;
+  // A whole file put back plays again.
+  renameOver(*whole, clip);
+  ASSERT_TRUE(runUntil(h, [&] { return t->live; }, 60)) << t->stream->describe();
+  EXPECT_FALSE(t->stream->degraded());
+  EXPECT_EQ(logs.problems("clip.mkv").size(), 1u);
+}
+
+/// A playlist of the numbered clip as a movie item (60 frames at 30 fps, numbered from 0) and
+/// a cube for `cube`; `other.mp4` (45 frames) and `good.mp4` (a copy of the clip) beside it.
+::testing::AssertionResult installMovieItemShow(Harness& h, const std::string& cube) {
+  auto good = test::makeNumberedClip(h.dir() / "good.mp4", 60, 30, media::VideoCodec::kH264);
+  if (!good) return ::testing::AssertionFailure() << good.error().describe();
+  auto other = test::makeNumberedClip(h.dir() / "other.mp4", 45, 30, media::VideoCodec::kH264, 160, 120, 500);
+  if (!other) return ::testing::AssertionFailure() << other.error().describe();
+  std::filesystem::copy_file(*good, h.dir() / "clip.mp4", std::filesystem::copy_options::overwrite_existing);
+  std::ofstream(h.dir() / "show.toml") << fmt::format(R"(
+[[kiosk.playlist]]
+name = "clip"
+entry = "clip.mp4"
+[[kiosk.playlist]]
+name = "cube"
+entry = "default"
+duration = "{}"
+)",
+                                                      cube);
+  return h.install(h.dir() / "show.toml");
+}
+
+// Makes sure a movie item whose file is replaced by rename while it plays switches to the new
+// clip at once, from its first frame, with one info line: the 45-frame clip put in place 30
+// frames into the 60-frame one plays for its 45 frames, where the old file had 30 left.
+// Example failure: the old inode plays on to its end (the decoder holds the old file open) and
+// the list moves on 30 frames after the rename.
+TEST(ShowStreams, AMovieItemsFileReplacedWhilePlayingSwitchesAtOnce) {
+  Harness h("item-replaced");
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(installMovieItemShow(h, "1h"));
+  ASSERT_EQ(h.item(), "clip");
+  h.run(31);  // 30 frames of show time into the clip
+  ASSERT_EQ(h.item(), "clip");
+  LogCapture logs;
+  renameOver(h.dir() / "other.mp4", h.dir() / "clip.mp4");
+  h.run(41);  // 40 more frames: past the old file's end, within the new one's 45
+  EXPECT_EQ(h.item(), "clip") << "the new clip plays from its start, not the old one's last 30 frames";
+  int more = 0;
+  while (h.item() == "clip" && more < 60) {
+    h.run(2);
+    ++more;
+  }
+  EXPECT_EQ(h.item(), "cube") << "the new clip ended and the list moved on";
+  EXPECT_LE(40 + more, 45 + 4) << "it played the new clip's 45 frames, not longer";
+  EXPECT_TRUE(logs.problems("clip.mp4").empty());
+  EXPECT_EQ(logs.lines("was replaced; playing the new content"), 1u);
+}
+
+class MovieItemFileBroken : public ::testing::TestWithParam<Break> {};
+
+// Makes sure a movie item whose file is deleted or emptied while it plays stops with one line
+// naming the file and what happened (the list moves on, as for any item that fails), and plays
+// again at its next turn once a good file is back.
+// Example failures: the deleted file's old inode plays on to its end; an emptied file fails
+// the decoder at some later read with a line that does not say what happened; the item never
+// plays again because its player kept the failure.
+TEST_P(MovieItemFileBroken, EndsTheItemOnceAndPlaysAgainWhenTheFileIsBack) {
+  const Break kind = GetParam();
+  Harness h("item-" + breakName(kind));
+  OPEN_OR_SKIP(h);
+  ASSERT_TRUE(installMovieItemShow(h, "2s"));
+  ASSERT_EQ(h.item(), "clip");
+  h.run(15);
+  ASSERT_EQ(h.item(), "clip");
+  const auto clip = h.dir() / "clip.mp4";
+  LogCapture logs;
+  if (kind == Break::kDeleted) {
+    std::filesystem::remove(clip);
+  } else {
+    cutTo(clip, 0);
+  }
+  h.run(3);
+  EXPECT_EQ(h.item(), "cube") << "the item ends at once";
+  const auto said = logs.problems("clip.mp4");
+  ASSERT_EQ(said.size(), 1u) << "one line for the broken file; got " << said.size()
+                             << (said.empty() ? "" : ": " + said.front());
+  EXPECT_NE(said[0].find(kind == Break::kDeleted ? "was deleted" : "was emptied"), std::string::npos) << said[0];
+  EXPECT_NE(said[0].find("show.toml:4"), std::string::npos) << "names the line of its entry: " << said[0];
+  renameOver(h.dir() / "good.mp4", clip);
+  ASSERT_TRUE(runUntil(h, [&] { return h.item() == "clip"; }, 60)) << "the clip's turn comes again";
+  h.run(10);
+  EXPECT_EQ(h.item(), "clip") << "and it plays";
+  EXPECT_EQ(logs.problems("clip.mp4").size(), 1u) << "nothing more to say once the file is back";
+}
+
+INSTANTIATE_TEST_SUITE_P(ShowStreams, MovieItemFileBroken, ::testing::Values(Break::kEmptied, Break::kDeleted),
+                         [](const ::testing::TestParamInfo<Break>& param) { return breakName(param.param); });
+
 }  // namespace
 }  // namespace basalt::kiosk
