@@ -182,6 +182,10 @@ Options:
   --replay PATH      play the devices recorded in a trace folder (basalt record) or an
                      hid-recorder file as if they were plugged in; dials drive LAVA's dial table
   --replay-once      play the recording once instead of looping
+  --camera SPEC      the camera a script's `tv.camera = on` shows (LAVA's Camera):
+                     v4l2:/dev/videoN, v4l2:NAME, libcamera[:ID], synthetic (colour bars) or
+                     replay:NAME.trace (a camera recorded with basalt record); it
+                     comes before the manifest's cameras
   --clock-start T    with --fast: the calendar time the show starts at, for trying opening
                      hours (2026-12-24T09:59:00Z)
   --status ADDR:PORT serve status and controls there (default: the manifest's [status];
@@ -251,6 +255,7 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
                               {"--record-frames", true},
                               {"--replay", true},
                               {"--replay-once"},
+                              {"--camera", true},
                               {"--clock-start", true},
                               {"--status", true},
                               {"--state-dir", true},
@@ -371,6 +376,12 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
       run.replay = std::filesystem::path(o.value);
     } else if (o.name == "--replay-once") {
       run.replayOnce = true;
+    } else if (o.name == "--camera") {
+      if (o.value.empty()) {
+        return fail(Errc::kInvalidArgument,
+                    "--camera needs v4l2:/dev/videoN, libcamera[:ID], synthetic or replay:NAME.trace");
+      }
+      run.camera = std::string(o.value);
     } else if (o.name == "--clock-start") {
       auto t = parseClockStart(o.value);
       if (!t) return std::unexpected(t.error());
@@ -584,6 +595,42 @@ std::string hostName() {
   return n;
 }
 
+/// The camera of `--camera SPEC` as a manifest device: the syntax of `basalt record --camera`
+/// (v4l2:/dev/videoN, v4l2:NAME, libcamera[:ID], synthetic) and replay:NAME.trace.
+Result<DeviceSpec> cameraOption(std::string_view text) {
+  auto request = parseDeviceSpec(text, devices::DeviceKind::kVideoSource, "camera");
+  if (!request) return std::unexpected(request.error());
+  DeviceSpec d;
+  d.kind = DeviceKind::kCamera;
+  const std::string& backend = request->match.backend;
+  if (backend == "v4l2") {
+    d.backend = DeviceBackend::kV4l2;
+  } else if (backend == "libcamera") {
+    d.backend = DeviceBackend::kLibcamera;
+  } else if (backend == "synthetic") {
+    d.backend = DeviceBackend::kSynthetic;
+  } else if (backend == "replay") {
+    d.backend = DeviceBackend::kReplay;
+    d.trace = request->match.path.empty() ? request->match.name : request->match.path;
+    std::error_code ec;
+    if (d.trace.empty() || !std::filesystem::is_regular_file(d.trace / "trace.toml", ec)) {
+      return fail(Errc::kNotFound,
+                  "no trace folder there: give replay:NAME.trace, a folder recorded with 'basalt "
+                  "record'",
+                  d.trace.string());
+    }
+  } else {
+    return fail(
+        Errc::kInvalidArgument,
+        fmt::format("--camera {}: a camera is v4l2:/dev/videoN, libcamera[:ID], synthetic or replay:NAME.trace", text));
+  }
+  d.match.vendor = request->match.vendor;
+  d.match.product = request->match.product;
+  d.match.name = request->match.name;
+  d.match.path = request->match.path;
+  return d;
+}
+
 }  // namespace
 
 int runShow(const RunOptions& options) {
@@ -602,6 +649,16 @@ int runShow(const RunOptions& options) {
     }
   }
   if (stderrIsJournal()) logToJournal(manifest.name);
+  if (options.camera) {
+    // The command line's camera goes first, so that a script's tv.camera = on shows it.
+    auto camera = cameraOption(*options.camera);
+    if (!camera) return failWith(camera.error(), "cannot start");
+    camera->name = "camera";
+    for (const DeviceSpec& d : manifest.devices) {
+      if (d.name == camera->name) camera->name = "command-line camera";
+    }
+    manifest.devices.insert(manifest.devices.begin(), std::move(*camera));
+  }
 
   const std::filesystem::path snapshotPath = options.snapshot ? *options.snapshot : options.outputDir / "snapshot.png";
   if (options.show && !isScriptFile(*options.show)) {

@@ -54,6 +54,7 @@ struct RunOptions {
   std::optional<std::int64_t> recordFrames;                           ///< --record-frames N
   std::optional<std::filesystem::path> replay;                        ///< a trace folder or hid-recorder file to replay
   bool replayOnce = false;                                            ///< play it once instead of looping
+  std::optional<std::string> camera;  ///< --camera SPEC: the camera a script's tv.camera = on shows
 };
 
 /// \brief Parses the arguments after `run`.

@@ -4,7 +4,8 @@
 // load_object reads models through runtime/formats (kiosk/show/show_host.h), save_image writes what
 // media::writeImage writes (LAVA's Sun rasterfile ras.im32 by default), and the VCR drives a
 // media::MoviePlayer shown on the video texture. A limit of this build, reported to the script's
-// author once, never silently: tv.camera works only where the show names a camera in its manifest.
+// author once, never silently: tv.camera works where the run has a camera (basalt run --camera, or
+// the show manifest's first camera).
 
 #include "kiosk/show/script_player.h"
 
@@ -261,8 +262,9 @@ Result<void> ScriptPlayer::tv(const script::TvRequest& request) {
     if (camera_) return {};
     if (!options_.camera) {
       return fail(Errc::kUnavailable,
-                  "this show has no camera: name one in the show manifest's [devices] (kind = \"camera\") and "
-                  "play the script from it; the show goes on without the camera");
+                  "this show has no camera: give one with basalt run --camera (v4l2:/dev/video0, synthetic, ...) "
+                  "or name one in the show manifest's [devices] (kind = \"camera\"); the show goes on without "
+                  "the camera");
     }
     auto camera = options_.camera();
     if (!camera) return std::unexpected(camera.error());
