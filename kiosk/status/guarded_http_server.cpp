@@ -21,14 +21,19 @@
 #include <charconv>
 #include <cstring>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
+
+#include "runtime/log.h"
 
 namespace basalt::kiosk {
 
 namespace {
 
 using SteadyClock = std::chrono::steady_clock;
+
+BASALT_LOG_CATEGORY(Guard, "kiosk");
 
 /// Answering takes CPU time from the show only when there is some to spare (nice 10).
 void yieldToTheShow() { ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10); }
@@ -272,7 +277,31 @@ GuardedHttpServer::~GuardedHttpServer() {
 
 GuardCounters GuardedHttpServer::guardCounters() const {
   return {refusedPerClient_.load(), refusedTotal_.load(), refusedDescriptors_.load(),
-          timedOut_.load(),         headTooLarge_.load(), bodyTooLarge_.load()};
+          timedOut_.load(),         headTooLarge_.load(), bodyTooLarge_.load(),
+          evicted_.load()};
+}
+
+void GuardedHttpServer::noteRefusal(std::string_view kind, std::string_view what) {
+  const auto now = SteadyClock::now();
+  std::uint64_t before = 0;
+  {
+    std::lock_guard lock(notedMutex_);
+    auto it = noted_.find(kind);
+    if (it == noted_.end()) {
+      noted_.emplace(std::string(kind), Noted{now, 0});
+    } else if (now - it->second.logged < std::chrono::minutes(1)) {
+      ++it->second.since;
+      return;
+    } else {
+      before = it->second.since;
+      it->second = Noted{now, 0};
+    }
+  }
+  if (before > 0) {
+    log::warn(kLogGuard, "status server: {} ({} more since the last line like it)", what, before);
+  } else {
+    log::warn(kLogGuard, "status server: {}", what);
+  }
 }
 
 std::size_t GuardedHttpServer::openConnections() const {
@@ -310,21 +339,31 @@ bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
     const std::string answer =
         answerText(503, "Service Unavailable", "the show needs its file descriptors; try again later");
     (void)::send(sock, answer.data(), answer.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
+    noteRefusal("descriptors", fmt::format("refused a connection from {}: the show needs its file descriptors "
+                                           "(a limit of {}, {} kept for the show)",
+                                           c->peer, files.rlim_cur, limits_.reservedDescriptors));
     close(std::move(c));  // no lingering: the descriptor is what is short
     return true;
   }
   std::string refusal;
+  std::string_view kind;
   {
     std::lock_guard lock(mutex_);
     std::size_t& fromClient = perClient_[c->peer];
-    if (open_ >= limits_.maxConnections) {
-      refusedTotal_.fetch_add(1, std::memory_order_relaxed);
-      refusal = fmt::format("the status server has {} connections open, its most; try again", open_);
-    } else if (fromClient >= limits_.maxPerClient) {
+    if (fromClient >= limits_.maxPerClient) {
       refusedPerClient_.fetch_add(1, std::memory_order_relaxed);
+      kind = "per-client";
       refusal = fmt::format("{} has {} connections open, the most one address may have; close one or try again",
                             c->peer, fromClient);
+    } else if (open_ >= limits_.maxConnections && evictWanted_ >= evictable_.load(std::memory_order_relaxed)) {
+      // Full, and every connection is at work (none reading a request or idle): refused.
+      refusedTotal_.fetch_add(1, std::memory_order_relaxed);
+      kind = "total";
+      refusal = fmt::format("the status server has {} connections open, its most, all at work; try again", open_);
     } else {
+      // Full of connections that send slowly or nothing (a slow-client attack, or idle
+      // kept-alive ones): this one comes in, and reception drops the slowest to make room.
+      if (open_ >= limits_.maxConnections) ++evictWanted_;
       ++fromClient;
       ++open_;
       c->admitted = true;
@@ -332,6 +371,7 @@ bool GuardedHttpServer::process_and_close_socket(socket_t sock) {
     if (fromClient == 0) perClient_.erase(c->peer);
   }
   if (!refusal.empty()) {
+    noteRefusal(kind, fmt::format("refused a connection with 503: {}", refusal));
     refuse(std::move(c), 503, refusal);
     return true;
   }
@@ -391,12 +431,16 @@ void GuardedHttpServer::receive() {
       }
       case Readiness::kHeadTooLarge:
         headTooLarge_.fetch_add(1, std::memory_order_relaxed);
+        noteRefusal("head", fmt::format("refused a request from {} with 431: its head is over {} bytes or {} fields",
+                                        c->peer, limits_.maxHeadBytes, limits_.maxHeaderFields));
         refuse(std::move(c), 431,
                fmt::format("request head too large: at most {} bytes and {} header fields", limits_.maxHeadBytes,
                            limits_.maxHeaderFields));
         return;
       case Readiness::kBodyTooLarge:
         bodyTooLarge_.fetch_add(1, std::memory_order_relaxed);
+        noteRefusal("body", fmt::format("refused a request from {} with 413: its body is over {} bytes", c->peer,
+                                        limits_.maxBodyBytes));
         refuse(std::move(c), 413, fmt::format("request too large: at most {} bytes", limits_.maxBodyBytes));
         return;
     }
@@ -423,6 +467,7 @@ void GuardedHttpServer::receive() {
         waiting.push_back(std::move(c));
       }
     }
+    evictSlowest(waiting);
     polled.assign(1, pollfd{wakeFd_, POLLIN, 0});
     auto next = SteadyClock::now() + std::chrono::seconds(1);
     for (const auto& c : waiting) {
@@ -466,6 +511,9 @@ void GuardedHttpServer::receive() {
           finish();
         } else {
           timedOut_.fetch_add(1, std::memory_order_relaxed);
+          noteRefusal("timeout", fmt::format("dropped a connection from {} with 408: its request was not all there "
+                                             "within {} s",
+                                             c->peer, std::chrono::duration<double>(limits_.requestTimeout).count()));
           refuse(std::move(c), 408,
                  fmt::format("the request was not all there within {} s",
                              std::chrono::duration<double>(limits_.requestTimeout).count()));
@@ -473,8 +521,39 @@ void GuardedHttpServer::receive() {
       }
     }
     std::erase_if(waiting, [](const auto& c) { return !c; });
+    evictable_.store(static_cast<std::size_t>(std::count_if(
+                         waiting.begin(), waiting.end(), [](const auto& c) { return c->admitted && !c->lingering; })),
+                     std::memory_order_relaxed);
   }
   for (auto& c : waiting) close(std::move(c));
+}
+
+void GuardedHttpServer::evictSlowest(std::vector<std::unique_ptr<Connection>>& waiting) {
+  std::size_t wanted = 0;
+  {
+    std::lock_guard lock(mutex_);
+    wanted = std::exchange(evictWanted_, 0);
+  }
+  for (; wanted > 0; --wanted) {
+    // The connection whose request (or idle wait) began longest ago: a slow client's, or one
+    // kept alive doing nothing. A real request is whole within milliseconds of its first byte.
+    auto slowest = waiting.end();
+    for (auto it = waiting.begin(); it != waiting.end(); ++it) {
+      if (!*it || !(*it)->admitted || (*it)->lingering) continue;
+      if (slowest == waiting.end() || (*it)->started < (*slowest)->started) slowest = it;
+    }
+    if (slowest == waiting.end()) break;
+    std::unique_ptr<Connection> c = std::move(*slowest);
+    evicted_.fetch_add(1, std::memory_order_relaxed);
+    noteRefusal("evicted", fmt::format("dropped a connection from {} with 503 to make room: {} connections were "
+                                       "open, the most, and it had sent the least for longest",
+                                       c->peer, limits_.maxConnections));
+    const std::string answer =
+        answerText(503, "Service Unavailable", "the status server is full and this connection was the slowest");
+    (void)::send(c->fd, answer.data(), answer.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
+    close(std::move(c));  // at once: its slot is what the new connection needs
+  }
+  std::erase_if(waiting, [](const auto& c) { return !c; });
 }
 
 void GuardedHttpServer::work() {

@@ -47,6 +47,7 @@ struct GuardCounters {
   std::uint64_t timedOut = 0;            ///< 408: a request not all there within requestTimeout
   std::uint64_t headTooLarge = 0;        ///< 431: head over maxHeadBytes or maxHeaderFields
   std::uint64_t bodyTooLarge = 0;        ///< 413 before the body was read (Content-Length)
+  std::uint64_t evicted = 0;             ///< 503: dropped to make room, the slowest of a full server
 };
 
 /// \brief An httplib::Server whose connections Basalt handles: httplib parses requests and
@@ -81,12 +82,18 @@ class GuardedHttpServer final : public httplib::Server {
   bool process_and_close_socket(socket_t sock) override;
 
   void receive();
+  /// On reception: drops as many of the slowest admitted connections as were admitted past
+  /// maxConnections.
+  void evictSlowest(std::vector<std::unique_ptr<Connection>>& waiting);
   void work();
   void serve(std::unique_ptr<Connection> c);
   void toReception(std::unique_ptr<Connection> c);
   void refuse(std::unique_ptr<Connection> c, int status, std::string_view why);
   void close(std::unique_ptr<Connection> c);
   void wakeReception() const;
+  /// Logs a refusal: the first of each kind at once, then at most one line a minute with the
+  /// number refused meanwhile, so that a flood is told without filling the log.
+  void noteRefusal(std::string_view kind, std::string_view what);
 
   HttpLimits limits_;
   int wakeFd_ = -1;  // eventfd: wakes reception for new connections and on stop
@@ -96,6 +103,7 @@ class GuardedHttpServer final : public httplib::Server {
   std::condition_variable workWake_;  // a connection in work_, or stopping_
   std::map<std::string, std::size_t> perClient_;
   std::size_t open_ = 0;
+  std::size_t evictWanted_ = 0;  // admitted past maxConnections: reception drops as many of the slowest
   std::vector<std::unique_ptr<Connection>> inbox_;  // for reception
   std::deque<std::unique_ptr<Connection>> work_;    // whole requests, at most maxConnections
 
@@ -108,6 +116,17 @@ class GuardedHttpServer final : public httplib::Server {
   std::atomic<std::uint64_t> timedOut_{0};
   std::atomic<std::uint64_t> headTooLarge_{0};
   std::atomic<std::uint64_t> bodyTooLarge_{0};
+  std::atomic<std::uint64_t> evicted_{0};
+  // Admitted connections in reception not yet answered (reading a request, or kept alive and
+  // idle): what a full server may drop to make room. Written by reception.
+  std::atomic<std::size_t> evictable_{0};
+
+  struct Noted {
+    std::chrono::steady_clock::time_point logged;
+    std::uint64_t since = 0;  // refused since that line
+  };
+  std::mutex notedMutex_;
+  std::map<std::string, Noted, std::less<>> noted_;
 };
 
 }  // namespace basalt::kiosk

@@ -476,6 +476,10 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
   out += fmt::format("basalt_http_rejected_total{{reason=\"rate\"}} {}\n", server.rejectedRate);
   out += fmt::format("basalt_http_rejected_total{{reason=\"auth\"}} {}\n", server.rejectedAuth);
   out += fmt::format("basalt_http_rejected_total{{reason=\"size\"}} {}\n", server.rejectedSize);
+  out += fmt::format("basalt_http_rejected_total{{reason=\"connections\"}} {}\n", server.rejectedConnections);
+  out += fmt::format("basalt_http_rejected_total{{reason=\"timeout\"}} {}\n", server.rejectedTimeout);
+  out += fmt::format("basalt_http_rejected_total{{reason=\"head\"}} {}\n", server.rejectedHead);
+  out += fmt::format("basalt_http_rejected_total{{reason=\"evicted\"}} {}\n", server.evicted);
   if (const std::optional<ProcessFigures>& p = s.process) {
     // The names and meanings of Prometheus' client libraries, so that the usual dashboards work.
     metric("process_cpu_seconds_total", "counter", "Total user and system CPU time spent in seconds.");

@@ -16,9 +16,13 @@ namespace basalt::kiosk {
 /// \brief Counters the HTTP server keeps about itself.
 struct ServerCounters {
   std::uint64_t requests = 0;
-  std::uint64_t rejectedRate = 0;  ///< 429
-  std::uint64_t rejectedAuth = 0;  ///< 401 and 403
-  std::uint64_t rejectedSize = 0;  ///< 413
+  std::uint64_t rejectedRate = 0;         ///< 429
+  std::uint64_t rejectedAuth = 0;         ///< 401 and 403
+  std::uint64_t rejectedSize = 0;         ///< 413
+  std::uint64_t rejectedConnections = 0;  ///< 503: past the connection limits or the descriptor reserve
+  std::uint64_t rejectedTimeout = 0;      ///< 408: a request not all there in time
+  std::uint64_t rejectedHead = 0;         ///< 431: a head too large
+  std::uint64_t evicted = 0;              ///< 503: the slowest connection of a full server, dropped
 };
 
 /// \brief "ok" when every device is live and every stream plays, "degraded" otherwise.

@@ -369,7 +369,17 @@ MachineFacts StatusServer::machineFacts(const std::string& manifest) {
 }
 
 ServerCounters StatusServer::counters() const {
-  return {requests_.load(), rejectedRate_.load(), rejectedAuth_.load(), rejectedSize_.load()};
+  ServerCounters c{requests_.load(), rejectedRate_.load(), rejectedAuth_.load(), rejectedSize_.load()};
+  if (server_) {
+    // What the connection guard refused before a request reached httplib.
+    const GuardCounters g = server_->guardCounters();
+    c.rejectedSize += g.bodyTooLarge;
+    c.rejectedConnections = g.refusedPerClient + g.refusedTotal + g.refusedDescriptors;
+    c.rejectedTimeout = g.timedOut;
+    c.rejectedHead = g.headTooLarge;
+    c.evicted = g.evicted;
+  }
+  return c;
 }
 
 Result<std::unique_ptr<StatusServer>> StatusServer::start(const StatusSpec& spec, StatusBoard& board) {

@@ -27,6 +27,7 @@
 
 #include "kiosk/status/status_board.h"
 #include "kiosk/status/status_server.h"
+#include "runtime/log.h"
 
 namespace basalt::kiosk {
 namespace {
@@ -311,6 +312,57 @@ TEST(StatusServerLimits, ConnectionsPastThePerClientLimitAreRefused) {
   }
   EXPECT_EQ(statusOf(again), 200) << again;
   for (const int fd : held) ::close(fd);
+}
+
+// Makes sure connections that send nothing cannot lock the technician out: 32 silent
+// connections from eight addresses (four each, the per-address most) fill the server, and a
+// ninth address still gets its answer, because the connection that has sent the least for
+// longest is dropped (503) to make room. Each kind of refusal is counted in /metrics and said
+// in the log, once for a flood. Example failures: the ninth address refused 503 while the
+// silent ones hold every slot for their 10 s (a slowloris lock-out); refusals in neither the
+// metrics nor the log.
+TEST(StatusServerLimits, SilentConnectionsCannotLockOutAClient) {
+  auto sink = std::make_shared<log::RingSink>(256);
+  log::addSink(sink);
+  Running r(spec());
+  constexpr std::size_t kTotal = 32;  // [status]'s connection most
+  std::vector<int> silent;
+  for (std::size_t i = 0; i < kTotal; ++i) {
+    const std::string from = fmt::format("127.0.0.{}", 10 + i / kPerClient);
+    const int fd = connectFrom(from.c_str(), r.port());
+    ASSERT_GE(fd, 0) << from;
+    silent.push_back(fd);
+    std::this_thread::sleep_for(5ms);  // admitted in this order: the first is the oldest
+  }
+  std::this_thread::sleep_for(300ms);
+  const auto began = std::chrono::steady_clock::now();
+  const int late = connectFrom("127.0.0.99", r.port());
+  ASSERT_GE(late, 0);
+  sendAll(late, "GET /health HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  const std::string answer = readAnswer(late, 5s);
+  ::close(late);
+  EXPECT_EQ(statusOf(answer), 200) << answer;
+  EXPECT_LT(std::chrono::steady_clock::now() - began, kRequestTimeout / 2) << "answered without waiting out a slot";
+  // The oldest silent connection was the one dropped, with a 503 that says why.
+  const std::string dropped = readAnswer(silent.front(), 2s);
+  EXPECT_EQ(statusOf(dropped), 503) << dropped;
+  EXPECT_NE(dropped.find("slowest"), std::string::npos) << dropped;
+  const ServerCounters counters = r.server->counters();
+  EXPECT_GE(counters.evicted, 1u);
+  // A fifth connection from an address that has four open is still refused, and counted.
+  const int fifth = connectFrom("127.0.0.11", r.port());
+  ASSERT_GE(fifth, 0);
+  const std::string refused = readAnswer(fifth, 3s);
+  ::close(fifth);
+  EXPECT_EQ(statusOf(refused), 503) << refused;
+  EXPECT_GE(r.server->counters().rejectedConnections, 1u);
+  for (const int fd : silent) ::close(fd);
+  std::size_t said = 0;
+  for (const auto& record : sink->snapshot(log::Level::kWarn)) {
+    said += record.message.find("status server: dropped a connection from 127.0.0.10") != std::string::npos;
+  }
+  log::removeSink(sink);
+  EXPECT_EQ(said, 1u) << "the first drop is said at once, in one line";
 }
 
 std::size_t openDescriptors() {
