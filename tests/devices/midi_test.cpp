@@ -69,7 +69,7 @@ TEST(MidiEncodings, SignMagnitude) {
 
 TEST(MidiEncodings, BinaryOffset) {
   MidiDecoder d(generic({{"dials", "16"}, {"encoding", "binary_offset"}}));
-  expectDelta(decode(d, {0xB0, 16, 0x41}), 0, kDetent);  // 65 = +1
+  expectDelta(decode(d, {0xB0, 16, 0x41}), 0, kDetent);   // 65 = +1
   expectDelta(decode(d, {0xB0, 16, 0x3F}), 0, -kDetent);  // 63 = -1
   expectDelta(decode(d, {0xB0, 16, 0x44}), 0, 4 * kDetent);
   EXPECT_TRUE(decode(d, {0xB0, 16, 0x40}).empty()) << "64 is no motion";
@@ -141,12 +141,12 @@ TEST(MidiProfiles, XTouchMiniMcMode) {
   EXPECT_EQ(p->dials, 9);
   EXPECT_EQ(p->buttons, 26);
   MidiDecoder d(*p);
-  expectDelta(decode(d, {0xB0, 0x10, 0x01}), 0, kDetent);      // V-Pot 1 clockwise
-  expectDelta(decode(d, {0xB0, 0x17, 0x43}), 7, -3 * kDetent);  // V-Pot 8 counter-clockwise 3
-  expectButton(decode(d, {0x90, 0x20, 0x7F}), 0, 1);            // V-Pot 1 push
-  expectButton(decode(d, {0x90, 0x59, 0x7F}), 8, 1);            // top row, first button (note 89)
-  expectButton(decode(d, {0x90, 0x5F, 0x7F}), 23, 1);           // bottom row, last button (note 95)
-  expectButton(decode(d, {0x90, 0x55, 0x7F}), 25, 1);           // layer B (note 85)
+  expectDelta(decode(d, {0xB0, 0x10, 0x01}), 0, kDetent);            // V-Pot 1 clockwise
+  expectDelta(decode(d, {0xB0, 0x17, 0x43}), 7, -3 * kDetent);       // V-Pot 8 counter-clockwise 3
+  expectButton(decode(d, {0x90, 0x20, 0x7F}), 0, 1);                 // V-Pot 1 push
+  expectButton(decode(d, {0x90, 0x59, 0x7F}), 8, 1);                 // top row, first button (note 89)
+  expectButton(decode(d, {0x90, 0x5F, 0x7F}), 23, 1);                // bottom row, last button (note 95)
+  expectButton(decode(d, {0x90, 0x55, 0x7F}), 25, 1);                // layer B (note 85)
   expectAbsolute(decode(d, {0xE8, 0x00, 0x40}), 8, 8192.0 / 16383);  // fader: pitch bend on channel 9
   // Half a turn (12 detents) puts the ring's dot on the middle LED of 11: Mackie ring CC 48, value 6.
   std::vector<MidiDecoder::Message> fb;
@@ -231,8 +231,8 @@ TEST(MidiProfiles, EncodingOverrideAndOptionErrors) {
 }
 
 TEST(MidiProfiles, DescriptorRoundTrip) {
-  for (const MidiProfile& p :
-       {*midiProfileByName("xtouch-mini-mc"), *midiProfileByName("midimix"), generic({{"nrpn", "5"}, {"dials", "1"}})}) {
+  for (const MidiProfile& p : {*midiProfileByName("xtouch-mini-mc"), *midiProfileByName("midimix"),
+                               generic({{"nrpn", "5"}, {"dials", "1"}})}) {
     const auto desc = midiDescriptor(p);
     EXPECT_TRUE(isMidiDescriptor(desc));
     auto back = parseMidiDescriptor(desc);
