@@ -294,7 +294,7 @@ Result<MidiProfile> makeGenericMidiProfile(const GenericMidiOptions& o) {
   const std::uint8_t ch = o.channel.value_or(0xff);
   std::vector<std::uint16_t> dials = o.dials;
   if (dials.empty() && o.nrpn.empty()) {
-    for (std::uint16_t cc = 0; cc < (o.highResolution ? 32 : 120); ++cc) dials.push_back(cc);
+    for (int cc = 0; cc < (o.highResolution ? 32 : 120); ++cc) dials.push_back(static_cast<std::uint16_t>(cc));
   }
   const double turns = o.encoding == MidiEncoding::kAbsolute ? 1.0 : kDetent;
   std::uint16_t index = 0;
