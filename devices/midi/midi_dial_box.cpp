@@ -68,13 +68,14 @@ std::string seqAddress(int client, int port) { return fmt::format("seq:{}:{}", c
 
 bool parseSeqAddress(std::string_view text, int& client, int& port) {
   if (!text.starts_with("seq:")) return false;
-  text.remove_prefix(4);
-  const auto colon = text.find(':');
-  if (colon == std::string_view::npos) return false;
-  const auto a = std::from_chars(text.data(), text.data() + colon, client);
-  const auto b = std::from_chars(text.data() + colon + 1, text.data() + text.size(), port);
-  return a.ec == std::errc{} && b.ec == std::errc{} && a.ptr == text.data() + colon &&
-         b.ptr == text.data() + text.size();
+  const std::string s(text.substr(4));
+  const auto colon = s.find(':');
+  if (colon == std::string::npos) return false;
+  const char* begin = s.c_str();
+  const char* end = begin + s.size();
+  const auto a = std::from_chars(begin, begin + colon, client);
+  const auto b = std::from_chars(begin + colon + 1, end, port);
+  return a.ec == std::errc{} && b.ec == std::errc{} && a.ptr == begin + colon && b.ptr == end;
 }
 
 struct PortEntry {
@@ -121,7 +122,7 @@ std::vector<PortEntry> listPorts(snd_seq_t* seq) {
 /// port and to the announce port (so that the port's exit is a loss), read on a thread.
 class MidiDialBox final : public DialBox {
  public:
-  MidiDialBox(DeviceInfo info, MidiProfile profile, int client, int port, const Clock& clock)
+  MidiDialBox(DeviceInfo info, const MidiProfile& profile, int client, int port, const Clock& clock)
       : DialBox(std::move(info), profile.dials, profile.buttons, true),
         decoder_(profile),
         client_(client),
