@@ -14,6 +14,7 @@
 
 #include <alsa/asoundlib.h>
 #include <poll.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <charconv>
@@ -43,6 +44,12 @@ using MidiEventPtr = std::unique_ptr<snd_midi_event_t, MidiEventCloser>;
 std::string alsaError(int err) { return snd_strerror(err); }
 
 Result<SeqPtr> openSeq(const char* clientName, int mode) {
+  // Without the kernel's sequencer, libasound would print its own error on stderr for every
+  // enumeration; its error handler is the process's (GStreamer's alsasink shares it), so it is
+  // not silenced: the node is looked for first.
+  if (::access("/dev/snd/seq", F_OK) != 0) {
+    return fail(Errc::kUnavailable, "cannot open the ALSA sequencer: no /dev/snd/seq (is snd-seq loaded?)");
+  }
   snd_seq_t* raw = nullptr;
   const int err = snd_seq_open(&raw, "default", SND_SEQ_OPEN_DUPLEX, mode);
   if (err < 0) {
