@@ -166,7 +166,8 @@ Result<HidRecordedDevice> parseMidiFile(std::span<const std::uint8_t> bytes, std
         if (!len) return std::unexpected(len.error());
         if (!r.has(*len)) return r.error("a meta event runs past its track");
         const auto data = bytes.subspan(r.pos_, *len);
-        if (type == 0x51 && *len == 3) tempos[tick] = (std::uint32_t{data[0]} << 16) | (data[1] << 8) | data[2];
+        if (type == 0x51 && *len == 3)
+          tempos[tick] = (std::uint32_t{data[0]} << 16) | (std::uint32_t{data[1]} << 8) | std::uint32_t{data[2]};
         if (type == 0x03 && trackName.empty()) trackName.assign(data.begin(), data.end());
         if (type == 0x01 && devices::isMidiDescriptor(data)) device.descriptor.assign(data.begin(), data.end());
         r.pos_ += *len;
