@@ -23,6 +23,7 @@
 #include "devices/midi/midi_decoder.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -290,6 +291,7 @@ Result<MidiProfile> makeGenericMidiProfile(const GenericMidiOptions& o) {
   MidiProfile p;
   p.name = "generic";
   p.title = "MIDI controller";
+  p.generic = o;
   // Unset channel: the profile lists channel 0 and the decoder matches any channel (see find()).
   const std::uint8_t ch = o.channel.value_or(0xff);
   std::vector<std::uint16_t> dials = o.dials;
@@ -420,6 +422,17 @@ Result<MidiProfile> midiProfileFromOptions(std::string_view portName,
 std::vector<std::uint8_t> midiDescriptor(const MidiProfile& profile) {
   std::string text(kMagic);
   text += fmt::format("name {}\ntitle {}\n", profile.name, profile.title);
+  if (profile.generic) {
+    // The generic map's settings, not its (up to 248) controls: the parser makes them again.
+    const GenericMidiOptions& g = *profile.generic;
+    const auto list = [](const std::vector<std::uint16_t>& v) {
+      return v.empty() ? std::string("-") : fmt::format("{}", fmt::join(v, ","));
+    };
+    text += fmt::format("generic {} {} {} {} {} {} {} {}\n", g.channel ? std::to_string(*g.channel) : "any",
+                        midiEncodingName(g.encoding), g.highResolution ? 1 : 0, g.echo ? 1 : 0, list(g.dials),
+                        list(g.buttons), list(g.notes), list(g.nrpn));
+    return {text.begin(), text.end()};
+  }
   for (const MidiControl& c : profile.controls) {
     char turns[32];
     const auto [end, ec] = std::to_chars(turns, turns + sizeof turns, c.turns);
@@ -452,6 +465,40 @@ Result<MidiProfile> parseMidiDescriptor(std::span<const std::uint8_t> descriptor
     if (line.starts_with("title ")) {
       p.title = line.substr(6);
       continue;
+    }
+    if (line.starts_with("generic ")) {
+      std::istringstream fields(line.substr(8));
+      std::string channel, encoding, dials, buttons, notes, nrpn;
+      int high = 0;
+      int echo = 0;
+      fields >> channel >> encoding >> high >> echo >> dials >> buttons >> notes >> nrpn;
+      GenericMidiOptions g;
+      const auto e = parseMidiEncoding(encoding);
+      bool ok = static_cast<bool>(fields) && e.has_value();
+      if (ok && channel != "any") {
+        unsigned ch = 16;
+        const auto [end, ec] = std::from_chars(channel.data(), channel.data() + channel.size(), ch);
+        ok = ec == std::errc{} && end == channel.data() + channel.size() && ch < 16;
+        g.channel = static_cast<std::uint8_t>(ch);
+      }
+      for (auto [text, out, max] : {std::tuple{&dials, &g.dials, 127}, std::tuple{&buttons, &g.buttons, 127},
+                                    std::tuple{&notes, &g.notes, 127}, std::tuple{&nrpn, &g.nrpn, 16383}}) {
+        if (!ok || *text == "-") continue;
+        auto l = numberList("descriptor", *text, static_cast<std::uint16_t>(max));
+        ok = l.has_value();
+        if (ok) *out = std::move(*l);
+      }
+      if (!ok) {
+        return fail(Errc::kParse,
+                    fmt::format("MIDI dial box descriptor line {}: '{}' is not a generic map", lineNo, line));
+      }
+      g.encoding = *e;
+      g.highResolution = high != 0;
+      g.echo = echo != 0;
+      auto made = makeGenericMidiProfile(g);
+      if (!made) return made;
+      made->title = p.title;
+      return made;
     }
     std::istringstream fields(line);
     std::string word, kind, encoding, role, turns, feedback;

@@ -69,6 +69,19 @@ struct MidiControl {
   std::uint16_t feedbackNumber = 0;
 };
 
+/// \brief The generic profile's settings (manifest keys `channel`, `dials`, `buttons`,
+/// `encoding`, `notes`, ...).
+struct GenericMidiOptions {
+  std::optional<std::uint8_t> channel;  ///< 0..15; unset: every channel (each channel's CCs are one bank)
+  std::vector<std::uint16_t> dials;  ///< CC numbers that are dials, in dial order (default: every CC 0..119, dial = CC)
+  std::vector<std::uint16_t> buttons;  ///< CC numbers that are buttons
+  std::vector<std::uint16_t> notes;    ///< notes that are buttons (default: every note, button = note)
+  std::vector<std::uint16_t> nrpn;     ///< NRPN parameters that are dials, after the CC dials
+  bool highResolution = false;         ///< dials' CCs are 14-bit MSB/LSB pairs (MSB 0..31)
+  MidiEncoding encoding = MidiEncoding::kAbsolute;
+  bool echo = false;  ///< send absolute dials' values back (motor faders, LED collars)
+};
+
 /// \brief A controller's controls, and how to recognise it by its ALSA client or port name.
 struct MidiProfile {
   std::string name;   ///< "xtouch-mini-mc", "nanokontrol2", "midimix", "generic"
@@ -78,6 +91,8 @@ struct MidiProfile {
   std::vector<MidiControl> controls;
   int dials = 0;    ///< one more than the highest dial index
   int buttons = 0;  ///< one more than the highest button index
+  /// The generic profile's settings, which its descriptor holds instead of every control.
+  std::optional<GenericMidiOptions> generic;
 
   /// \brief "9 dials, 26 buttons".
   [[nodiscard]] std::string shape() const;
@@ -91,19 +106,6 @@ const std::vector<MidiProfile>& builtinMidiProfiles();
 /// \brief The built-in profile whose port names match `portName` (client and port name), or the
 /// generic one.
 [[nodiscard]] MidiProfile midiProfileForPort(std::string_view portName);
-
-/// \brief The generic profile's settings (manifest keys `channel`, `dials`, `buttons`,
-/// `encoding`, `notes`, ...).
-struct GenericMidiOptions {
-  std::optional<std::uint8_t> channel;  ///< 0..15; unset: every channel (each channel's CCs are one bank)
-  std::vector<std::uint16_t> dials;  ///< CC numbers that are dials, in dial order (default: every CC 0..119, dial = CC)
-  std::vector<std::uint16_t> buttons;  ///< CC numbers that are buttons
-  std::vector<std::uint16_t> notes;    ///< notes that are buttons (default: every note, button = note)
-  std::vector<std::uint16_t> nrpn;     ///< NRPN parameters that are dials, after the CC dials
-  bool highResolution = false;         ///< dials' CCs are 14-bit MSB/LSB pairs (MSB 0..31)
-  MidiEncoding encoding = MidiEncoding::kAbsolute;
-  bool echo = false;  ///< send absolute dials' values back (motor faders, LED collars)
-};
 
 /// \brief The generic profile: `options` made into controls.
 [[nodiscard]] Result<MidiProfile> makeGenericMidiProfile(const GenericMidiOptions& options);

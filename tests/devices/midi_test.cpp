@@ -248,6 +248,13 @@ TEST(MidiProfiles, DescriptorRoundTrip) {
       EXPECT_EQ(back->controls[i].feedback, p.controls[i].feedback);
     }
   }
+  // The generic map is held as its settings, not its 248 controls (traces keep it twice).
+  EXPECT_LT(midiDescriptor(generic({})).size(), 200u);
+  auto g = parseMidiDescriptor(midiDescriptor(generic({{"channel", "4"}, {"notes", "36-39"}, {"echo", "true"}})));
+  ASSERT_TRUE(g) << g.error().describe();
+  MidiDecoder d(*g);
+  expectButton(decode(d, {0x93, 37, 100}), 1, 1);
+  EXPECT_TRUE(decode(d, {0x90, 37, 100}).empty()) << "the channel survives the descriptor";
   const std::uint8_t hid[] = {0x05, 0x01, 0x09, 0x37};
   EXPECT_FALSE(isMidiDescriptor(hid));
 }
