@@ -23,7 +23,8 @@ Lists the dial boxes, cameras and capture cards connected to this machine, what 
 use each one as, and why a device cannot be opened, with what to do about it.
 
 Options:
-  --replay PATH     also list the devices recorded in a trace folder or hid-recorder file
+  --replay PATH     also list the devices recorded in a trace folder, hid-recorder file or
+                    Standard MIDI File
   --serial PORT     also offer PORT to an SGI dial box (repeatable; USB serial adapters are
                     listed anyway)
   --synthetic       also list the simulated twins (a synthetic dial box and camera)

@@ -148,14 +148,15 @@ std::string_view recordUsage() {
   return R"(Usage: basalt record --output NAME.trace [options]
 
 Records live devices into a trace folder: trace.toml, one hid-recorder file per dial box
-(replayable with hid-replay too) and one video file per camera, with the original timestamps.
+(replayable with hid-replay too; a MIDI controller's is a Standard MIDI File that aplaymidi
+plays) and one video file per camera, with the original timestamps.
 Replay it with 'basalt run --replay NAME.trace'. Devices that are unplugged while recording are
 recorded again when they come back.
 
 Options:
   --output DIR      the trace folder to create (must not exist or be empty)
   --dial SPEC       a dial box to record (repeatable): hid, hid:077d:0410, hid:/dev/hidraw3,
-                    serial:/dev/ttyUSB0, synthetic
+                    serial:/dev/ttyUSB0, midi:X-TOUCH MINI, midi:seq:24:0, synthetic
   --camera SPEC     a video source to record (repeatable): v4l2:/dev/video0, v4l2:NAME,
                     libcamera, synthetic
   --synthetic       record the synthetic dial box and camera (a demo trace, no hardware needed)

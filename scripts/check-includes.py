@@ -42,6 +42,7 @@ LIBRARIES = [
     (re.compile(r"^(hidapi|libusb-1\.0)/|^(hidapi\.h|libusb\.h)$"), "hidapi/libusb", "devices/hid"),
     (re.compile(r"^libcamera/"), "libcamera", "devices/libcamera"),
     (re.compile(r"^libudev\.h$"), "libudev", "devices/udev"),
+    (re.compile(r"^alsa/"), "ALSA (libasound)", "devices/midi"),
 ]
 SOURCE_DIRS = ["runtime", "devices", "media", "render", "sim", "kiosk", "app", "tools"]
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^">]+)[">]')

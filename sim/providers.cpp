@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 
 #include "devices/hid/dial_decoder.h"
+#include "devices/midi/midi_decoder.h"
+#include "sim/midi_file.h"
 #include "sim/raw_video.h"
 #include "sim/replay.h"
 
@@ -216,7 +218,30 @@ Result<std::shared_ptr<devices::VideoSource>> SyntheticProvider::openVideoSource
 ReplayProvider::ReplayProvider(TraceVideoReaderFactory videoReader)
     : videoReader_(videoReaderFactory(std::move(videoReader))) {}
 
+Result<void> ReplayProvider::addMidiFile(const std::filesystem::path& file) {
+  auto rec = readMidiFile(file);
+  if (!rec) return std::unexpected(rec.error());
+  Entry e;
+  e.candidate.kind = devices::DeviceKind::kDialBox;
+  e.candidate.info.name = rec->name;
+  e.candidate.info.backend = "replay";
+  e.candidate.info.bus = "virtual";
+  e.candidate.info.path = file.string();
+  auto profile = devices::parseMidiDescriptor(rec->descriptor);
+  if (profile) {
+    e.candidate.usage = fmt::format("{} (MIDI, profile {}): {}, {} messages", profile->title, profile->name,
+                                    profile->shape(), rec->reports.size());
+  } else {
+    e.candidate.problem = profile.error().describe();
+  }
+  e.requestName = file.stem().string();
+  e.hid = std::move(*rec);
+  entries_.push_back(std::move(e));
+  return {};
+}
+
 Result<void> ReplayProvider::addHidRecording(const std::filesystem::path& file) {
+  if (isMidiFilePath(file)) return addMidiFile(file);
   auto rec = readHidRecording(file);
   if (!rec) return std::unexpected(rec.error());
   const bool multi = rec->devices.size() > 1;
@@ -253,7 +278,12 @@ Result<void> ReplayProvider::addTrace(const std::filesystem::path& folder) {
     e.candidate.info = d.info;
     e.candidate.info.backend = "replay";
     e.candidate.info.path = (folder / d.file).string();
-    if (d.kind == devices::DeviceKind::kDialBox) {
+    if (d.kind == devices::DeviceKind::kDialBox && isMidiFilePath(d.file)) {
+      auto rec = readMidiFile(folder / d.file);
+      if (!rec) return std::unexpected(rec.error());
+      e.hid = std::move(*rec);
+      e.candidate.usage = fmt::format("recorded {} with {} MIDI messages", d.info.name, e.hid.reports.size());
+    } else if (d.kind == devices::DeviceKind::kDialBox) {
       auto rec = readHidRecording(folder / d.file);
       if (!rec) return std::unexpected(rec.error());
       if (rec->devices.empty()) return fail(Errc::kParse, "the recording has no device", (folder / d.file).string());

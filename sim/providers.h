@@ -88,7 +88,9 @@ class ReplayProvider final : public devices::DeviceProvider {
 
   /// \brief Adds every device of a trace folder. Errors name the file and line.
   [[nodiscard]] Result<void> addTrace(const std::filesystem::path& folder);
-  /// \brief Adds every device of an hid-recorder file.
+  /// \brief Adds a Standard MIDI File (Basalt's, or one from arecordmidi) as a MIDI dial box.
+  [[nodiscard]] Result<void> addMidiFile(const std::filesystem::path& file);
+  /// \brief Adds every device of an hid-recorder file (a .mid file: addMidiFile()).
   [[nodiscard]] Result<void> addHidRecording(const std::filesystem::path& file);
 
   /// \brief One request per recorded device, named as recorded, matched by path.

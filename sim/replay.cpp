@@ -16,15 +16,25 @@ namespace basalt::sim {
 Result<std::unique_ptr<ReplayDialBox>> ReplayDialBox::create(devices::DeviceInfo info,
                                                              const HidRecordedDevice& recording, const Clock& clock,
                                                              bool loop) {
+  if (devices::isMidiDescriptor(recording.descriptor)) {
+    auto profile = devices::parseMidiDescriptor(recording.descriptor);
+    if (!profile) return std::unexpected(profile.error());
+    const int dials = profile->dials;
+    const int buttons = profile->buttons;
+    return std::unique_ptr<ReplayDialBox>(new ReplayDialBox(
+        std::move(info), recording, devices::MidiDecoder(std::move(*profile)), dials, buttons, clock, loop));
+  }
   auto decoder = devices::DialDecoder::create(recording.vendor, recording.product, recording.descriptor, info.path);
   if (!decoder) return std::unexpected(decoder.error());
+  const int dials = decoder->dialCount();
+  const int buttons = decoder->buttonCount();
   return std::unique_ptr<ReplayDialBox>(
-      new ReplayDialBox(std::move(info), recording, std::move(*decoder), clock, loop));
+      new ReplayDialBox(std::move(info), recording, std::move(*decoder), dials, buttons, clock, loop));
 }
 
-ReplayDialBox::ReplayDialBox(devices::DeviceInfo info, const HidRecordedDevice& recording, devices::DialDecoder decoder,
-                             const Clock& clock, bool loop)
-    : DialBox(std::move(info), decoder.dialCount(), decoder.buttonCount(), true),
+ReplayDialBox::ReplayDialBox(devices::DeviceInfo info, const HidRecordedDevice& recording, Decoder decoder, int dials,
+                             int buttons, const Clock& clock, bool loop)
+    : DialBox(std::move(info), dials, buttons, true),
       reports_(recording.reports),
       decoder_(std::move(decoder)),
       clock_(clock),
@@ -33,7 +43,7 @@ ReplayDialBox::ReplayDialBox(devices::DeviceInfo info, const HidRecordedDevice& 
 }
 
 Result<void> ReplayDialBox::doOpen() {
-  decoder_.reset();
+  std::visit([](auto& d) { d.reset(); }, decoder_);
   next_ = 0;
   finished_ = false;
   origin_ = clock_.now();
@@ -55,13 +65,13 @@ void ReplayDialBox::doService(Nanos now) {
                                             : Nanos{std::chrono::milliseconds(1)};
       origin_ += reports_.back().time + std::max(gap, Nanos{1});
       next_ = 0;
-      decoder_.reset();
+      std::visit([](auto& d) { d.reset(); }, decoder_);
     }
     const HidReport& r = reports_[next_];
     const Nanos due = origin_ + r.time;
     if (due > now) return;
     tapReport(due, r.bytes);
-    const std::size_t n = decoder_.decode(r.bytes, events);
+    const std::size_t n = std::visit([&](auto& d) { return d.decode(r.bytes, events); }, decoder_);
     for (std::size_t i = 0; i < n; ++i) {
       events[i].time = due;
       emit(events[i]);

@@ -7,16 +7,19 @@
 /// fast as the frame loop runs under a ManualClock, looping or once.
 
 #include <memory>
+#include <variant>
 
 #include "devices/dial_box.h"
 #include "devices/hid/dial_decoder.h"
+#include "devices/midi/midi_decoder.h"
 #include "devices/video_source.h"
 #include "sim/hid_recording.h"
 #include "sim/trace_video.h"
 
 namespace basalt::sim {
 
-/// \brief A recorded HID device played back. Its raw reports go to the report tap unchanged, so
+/// \brief A recorded HID device (or MIDI dial box: its descriptor is then a MIDI profile and its
+/// reports MIDI messages) played back. Its raw reports go to the report tap unchanged, so
 /// recording a replay gives the same file.
 class ReplayDialBox final : public devices::DialBox {
  public:
@@ -29,14 +32,15 @@ class ReplayDialBox final : public devices::DialBox {
   [[nodiscard]] bool finished() const { return finished_; }
 
  private:
-  ReplayDialBox(devices::DeviceInfo info, const HidRecordedDevice& recording, devices::DialDecoder decoder,
+  using Decoder = std::variant<devices::DialDecoder, devices::MidiDecoder>;
+  ReplayDialBox(devices::DeviceInfo info, const HidRecordedDevice& recording, Decoder decoder, int dials, int buttons,
                 const Clock& clock, bool loop);
   Result<void> doOpen() override;
   void doClose() override;
   void doService(Nanos now) override;
 
   std::vector<HidReport> reports_;
-  devices::DialDecoder decoder_;
+  Decoder decoder_;
   const Clock& clock_;
   bool loop_;
   std::size_t next_ = 0;

@@ -20,8 +20,10 @@
 #include <fmt/chrono.h>
 #include <fmt/format.h>
 
+#include "devices/midi/midi_decoder.h"
 #include "sim/hid_comments.h"
 #include "sim/hid_recording.h"
+#include "sim/midi_file.h"
 #include "sim/raw_video.h"
 
 namespace basalt::sim {
@@ -346,7 +348,7 @@ constexpr std::string_view kMarkName = ".recording";
 /// Whether a file in a trace folder is one a recording writes before trace.toml.
 bool writtenWhileRecording(const std::filesystem::path& name) {
   const std::filesystem::path ext = name.extension();
-  return name == kMarkName || ext == ".hid" || ext == ".mkv" || ext == ".bvraw";
+  return name == kMarkName || ext == ".hid" || ext == ".mid" || ext == ".mkv" || ext == ".bvraw";
 }
 
 /// Opens (or creates) the mark and takes its lock; false in `busy` when another process holds it.
@@ -497,6 +499,19 @@ Result<void> TraceRecorder::addDialBox(DeviceId id, const std::string& name, con
   d.file = name + ".hid";
   d.descriptor = descriptor;
   DialFile f;
+  if (devices::isMidiDescriptor(descriptor)) {
+    // A MIDI dial box records as a Standard MIDI File (aplaymidi plays it), written by finish().
+    d.file = name + ".mid";
+    f.out.open(folder_ / d.file, std::ios::binary | std::ios::trunc);
+    if (!f.out) return fail(Errc::kIo, "cannot create the recording file", (folder_ / d.file).string());
+    f.midi = true;
+    f.messages.name = info.name;
+    f.messages.descriptor = descriptor;
+    f.index = info_.devices.size();
+    info_.devices.push_back(std::move(d));
+    dials_.emplace(id, std::move(f));
+    return {};
+  }
   f.out.open(folder_ / d.file, std::ios::binary | std::ios::trunc);
   if (!f.out) return fail(Errc::kIo, "cannot create the recording file", (folder_ / d.file).string());
   HidRecordedDevice header;
@@ -544,6 +559,12 @@ void TraceRecorder::onReport(DeviceId device, Nanos time, std::span<const std::u
   if (stopping_) return;
   auto it = dials_.find(device);
   if (it == dials_.end()) return;
+  if (it->second.midi) {
+    it->second.messages.reports.push_back({time - start_, {report.begin(), report.end()}});
+    ++reports_;
+    lastTime_ = std::max(lastTime_, time - start_);
+    return;
+  }
   it->second.out << it->second.comments.reportLine(report) << HidRecordingWriter::reportLine(time - start_, report);
   if (!it->second.out)
     noteError(Error(Errc::kIo, "cannot write the recording (disk full?)", info_.devices[it->second.index].file));
@@ -621,6 +642,10 @@ Result<TraceInfo> TraceRecorder::finish() {
   stopWriting();
   std::lock_guard lock(mutex_);
   for (auto& [id, f] : dials_) {
+    if (f.midi) {
+      const std::vector<std::uint8_t> smf = formatMidiFile(f.messages);
+      f.out.write(reinterpret_cast<const char*>(smf.data()), static_cast<std::streamsize>(smf.size()));
+    }
     f.out.flush();
     if (!f.out) noteError(Error(Errc::kIo, "cannot write the recording (disk full?)", info_.devices[f.index].file));
     f.out.close();

@@ -26,6 +26,7 @@
 #include "runtime/error.h"
 #include "runtime/unique_fd.h"
 #include "sim/hid_comments.h"
+#include "sim/hid_recording.h"
 #include "sim/trace_video.h"
 
 namespace basalt::sim {
@@ -120,8 +121,10 @@ class TraceRecorder final : public devices::ReportTap, public devices::FrameTap 
 
   struct DialFile {
     std::ofstream out;
-    std::size_t index = 0;  // in info_.devices
-    HidComments comments;   // decodes each report into the comment before its E: line
+    std::size_t index = 0;       // in info_.devices
+    HidComments comments;        // decodes each report into the comment before its E: line
+    bool midi = false;           // a MIDI dial box: its messages are kept and written as a Standard MIDI File
+    HidRecordedDevice messages;  // MIDI dial boxes: the messages so far
   };
   struct VideoFile {
     std::unique_ptr<TraceVideoWriter> writer;

@@ -23,9 +23,11 @@
 #include <fmt/format.h>
 #include <fmt/std.h>
 
+#include "devices/midi/midi_decoder.h"
 #include "kiosk/manifest/time_zone.h"
 #include "runtime/frame.h"
 #include "sim/hid_recording.h"
+#include "sim/midi_file.h"
 
 namespace basalt::kiosk {
 
@@ -106,6 +108,7 @@ std::string_view deviceBackendName(DeviceBackend backend) {
     case DeviceBackend::kReplay: return "replay";
     case DeviceBackend::kSynthetic: return "synthetic";
     case DeviceBackend::kSerial: return "serial";
+    case DeviceBackend::kMidi: return "midi";
   }
   return "?";
 }
@@ -1196,6 +1199,11 @@ class Reader {
 
   /// Why a hid-recorder file cannot be replayed as a dial box, or nothing.
   static std::optional<std::string> checkHidRecording(const std::filesystem::path& file) {
+    if (sim::isMidiFilePath(file)) {
+      auto midi = sim::readMidiFile(file);
+      if (!midi) return fmt::format("is not a Standard MIDI File: {}", midi.error().message());
+      return std::nullopt;
+    }
     auto recording = sim::readHidRecording(file);
     if (!recording) return fmt::format("is not a hid-recorder file: {}", recording.error().message());
     if (recording->devices.empty()) return std::string("records no device (no R: or E: lines)");
@@ -1217,7 +1225,7 @@ class Reader {
       d.line = lineOf(*t);
       checkKeys(*t, path,
                 {"kind", "backend", "match", "trace", "script", "loop", "required", "size", "gain", "acceleration",
-                 "mirror", "faults", "format"});
+                 "mirror", "faults", "format", "midi"});
       const auto kind =
           choice<DeviceKind>(*t, "kind", path, {{"dial_box", DeviceKind::kDialBox}, {"camera", DeviceKind::kCamera}});
       if (!t->get("kind")) error(d.line, fmt::format("{}: needs kind = \"dial_box\" or \"camera\"", path));
@@ -1225,25 +1233,29 @@ class Reader {
       const auto backend = choice<DeviceBackend>(*t, "backend", path,
                                                  {{"hid", DeviceBackend::kHid},
                                                   {"serial", DeviceBackend::kSerial},
+                                                  {"midi", DeviceBackend::kMidi},
                                                   {"v4l2", DeviceBackend::kV4l2},
                                                   {"libcamera", DeviceBackend::kLibcamera},
                                                   {"replay", DeviceBackend::kReplay},
                                                   {"synthetic", DeviceBackend::kSynthetic}});
       if (!t->get("backend")) {
-        error(d.line, fmt::format("{}: needs backend = \"hid\", \"serial\", \"v4l2\", \"libcamera\", \"replay\" "
-                                  "or \"synthetic\"",
+        error(d.line, fmt::format("{}: needs backend = \"hid\", \"serial\", \"midi\", \"v4l2\", \"libcamera\", "
+                                  "\"replay\" or \"synthetic\"",
                                   path));
       }
       if (backend) d.backend = *backend;
       if (kind && backend) {
         const bool dialBackend = *backend == DeviceBackend::kHid || *backend == DeviceBackend::kReplay ||
-                                 *backend == DeviceBackend::kSynthetic || *backend == DeviceBackend::kSerial;
-        const bool cameraBackend = *backend != DeviceBackend::kHid && *backend != DeviceBackend::kSerial;
+                                 *backend == DeviceBackend::kSynthetic || *backend == DeviceBackend::kSerial ||
+                                 *backend == DeviceBackend::kMidi;
+        const bool cameraBackend =
+            *backend != DeviceBackend::kHid && *backend != DeviceBackend::kSerial && *backend != DeviceBackend::kMidi;
         if ((*kind == DeviceKind::kDialBox && !dialBackend) || (*kind == DeviceKind::kCamera && !cameraBackend)) {
           error(lineOf(*t->get("backend")),
-                fmt::format("{}: a {} cannot use the {} backend; a dial_box uses hid, serial, replay or synthetic, a "
-                            "camera v4l2, libcamera, replay or synthetic",
-                            path, deviceKindName(*kind), deviceBackendName(*backend)));
+                fmt::format(
+                    "{}: a {} cannot use the {} backend; a dial_box uses hid, serial, midi, replay or synthetic, a "
+                    "camera v4l2, libcamera, replay or synthetic",
+                    path, deviceKindName(*kind), deviceBackendName(*backend)));
         }
       }
       if (const toml::table* m = table(*t, "match", path)) readMatch(*m, path + ".match", d);
@@ -1287,6 +1299,7 @@ class Reader {
       if (d.backend != DeviceBackend::kReplay && t->get("trace")) {
         warning(lineOf(*t->get("trace")), fmt::format("{}.trace: only the replay backend reads a trace", path));
       }
+      if (const toml::node* midi = t->get("midi")) readMidiOptions(*midi, path, d);
       if (const toml::node* script = t->get("script")) readSyntheticScript(*script, path, d);
       if (t->get("script") && d.backend != DeviceBackend::kSynthetic) {
         warning(lineOf(*t->get("script")), fmt::format("{}.script: only the synthetic backend plays a script", path));
@@ -1343,6 +1356,59 @@ class Reader {
     }
   }
 
+  /// `midi = { profile = "xtouch-mini-mc", encoding = "sign_magnitude", channel = 1, dials = [16, 17],
+  /// buttons = [...], notes = [...], nrpn = [...], high_resolution = false, echo = false }`: the midi
+  /// backend's options, checked here as the backend will read them.
+  void readMidiOptions(const toml::node& node, const std::string& path, DeviceSpec& d) {
+    const std::string mp = path + ".midi";
+    const toml::table* m = node.as_table();
+    if (!m) {
+      error(lineOf(node), fmt::format("{}: must be a table: midi = {{ profile = \"xtouch-mini-mc\" }}", mp));
+      return;
+    }
+    if (d.backend != DeviceBackend::kMidi) {
+      warning(lineOf(node), fmt::format("{}: only the midi backend reads it; this is ignored", mp));
+      return;
+    }
+    checkKeys(*m, mp,
+              {"profile", "encoding", "channel", "dials", "buttons", "notes", "nrpn", "high_resolution", "echo"});
+    std::map<std::string, std::string> options;
+    for (const char* key : {"profile", "encoding"}) {
+      if (auto v = string(*m, key, mp)) options[key] = *v;
+    }
+    if (auto channel = integer(*m, "channel", mp, 1, 16)) options["channel"] = std::to_string(*channel);
+    for (const char* key : {"dials", "buttons", "notes", "nrpn"}) {
+      const toml::node* list = m->get(key);
+      if (!list) continue;
+      const toml::array* a = list->as_array();
+      std::string text;
+      bool ok = a != nullptr;
+      if (a) {
+        for (const toml::node& item : *a) {
+          const auto* n = item.as_integer();
+          ok = ok && n && n->get() >= 0 && n->get() <= 16383;
+          if (!ok) break;
+          if (!text.empty()) text += ',';
+          text += std::to_string(n->get());
+        }
+      }
+      if (!ok || text.empty()) {
+        error(lineOf(*list), fmt::format("{}.{}: must be a list of numbers: {} = [16, 17, 18]", mp, key, key));
+        continue;
+      }
+      options[key] = text;
+    }
+    for (const char* key : {"high_resolution", "echo"}) {
+      if (auto v = boolean(*m, key, mp)) options[key] = *v ? "true" : "false";
+    }
+    // The backend's own check, so that `basalt check` names what the device would refuse.
+    if (auto profile = devices::midiProfileFromOptions(d.match.name, options); !profile) {
+      error(lineOf(node), fmt::format("{}: {}", mp, profile.error().message()));
+      return;
+    }
+    d.midi = std::move(options);
+  }
+
   void readMatch(const toml::table& m, const std::string& path, DeviceSpec& d) {
     checkKeys(m, path, {"usb", "name", "path", "serial"});
     if (auto usb = string(m, "usb", path)) {
@@ -1366,7 +1432,12 @@ class Reader {
     }
     if (auto name = string(m, "name", path)) d.match.name = *name;
     if (auto p = string(m, "path", path)) {
-      if (!p->starts_with("/dev/") && !p->starts_with("usb:")) {
+      if (d.backend == DeviceBackend::kMidi && !p->starts_with("seq:")) {
+        error(lineOf(*m.get("path")),
+              fmt::format("{}.path: '{}': a MIDI port's path is seq:CLIENT:PORT (aconnect -l lists them); match a "
+                          "controller by name = \"X-TOUCH MINI\" to survive replugging",
+                          path, *p));
+      } else if (d.backend != DeviceBackend::kMidi && !p->starts_with("/dev/") && !p->starts_with("usb:")) {
         error(lineOf(*m.get("path")), fmt::format("{}.path: '{}' is neither a /dev node nor a usb: path", path, *p));
       } else {
         d.match.path = *p;

@@ -158,7 +158,7 @@ struct MediaSpec {
 };
 
 enum class DeviceKind : std::uint8_t { kDialBox, kCamera };
-enum class DeviceBackend : std::uint8_t { kHid, kV4l2, kLibcamera, kReplay, kSynthetic, kSerial };
+enum class DeviceBackend : std::uint8_t { kHid, kV4l2, kLibcamera, kReplay, kSynthetic, kSerial, kMidi };
 std::string_view deviceKindName(DeviceKind kind);
 std::string_view deviceBackendName(DeviceBackend backend);
 
@@ -207,6 +207,9 @@ struct DeviceSpec {
   std::vector<SyntheticFault> faults;  ///< synthetic camera: what goes wrong, when
   double gain = 1;                     ///< dial box: multiplies every dial's gain
   double acceleration = 0;             ///< dial box: every dial's acceleration unless a binding says otherwise
+  /// midi dial box: `midi = { profile, encoding, channel, dials, buttons, notes, nrpn,
+  /// high_resolution, echo }` as the backend's options (devices/midi/midi_backend.h), checked
+  std::map<std::string, std::string> midi;
   int line = 0;
 };
 

@@ -4,6 +4,7 @@
 
 #include "devices/hid/hid_backend.h"
 #include "devices/libcamera/libcamera_camera.h"
+#include "devices/midi/midi_backend.h"
 #include "devices/serial/sgi_dial_box.h"
 #include "devices/v4l2/v4l2_camera.h"
 #include "runtime/log.h"
@@ -19,17 +20,17 @@ Result<devices::DeviceRequest> parseDeviceSpec(std::string_view text, devices::D
   r.kind = kind;
   const auto colon = text.find(':');
   r.match.backend = std::string(text.substr(0, colon));
-  static constexpr std::string_view kBackends[] = {"hid", "serial", "v4l2", "libcamera", "synthetic", "replay"};
+  static constexpr std::string_view kBackends[] = {"hid", "serial", "midi", "v4l2", "libcamera", "synthetic", "replay"};
   if (std::find(std::begin(kBackends), std::end(kBackends), r.match.backend) == std::end(kBackends)) {
     return fail(Errc::kInvalidArgument,
-                fmt::format("'{}' does not start with a backend: hid, serial, v4l2, libcamera, synthetic or replay "
-                            "(e.g. hid:077d:0410, v4l2:/dev/video0)",
+                fmt::format("'{}' does not start with a backend: hid, serial, midi, v4l2, libcamera, synthetic or "
+                            "replay (e.g. hid:077d:0410, midi:X-TOUCH MINI, v4l2:/dev/video0)",
                             text));
   }
   if (colon == std::string_view::npos) return r;
   const std::string_view rest = text.substr(colon + 1);
   if (rest.size() == 9 && rest[4] == ':' && parseVendorProduct(rest, r.match)) return r;
-  if (rest.starts_with("/") || rest.starts_with("usb:") || r.match.backend == "libcamera" ||
+  if (rest.starts_with("/") || rest.starts_with("usb:") || rest.starts_with("seq:") || r.match.backend == "libcamera" ||
       r.match.backend == "synthetic") {
     r.match.path = std::string(rest);
   } else {
@@ -42,6 +43,7 @@ std::vector<std::unique_ptr<devices::DeviceProvider>> allProviders(const std::ve
   std::vector<std::unique_ptr<devices::DeviceProvider>> out;
   out.push_back(std::make_unique<devices::HidProvider>());
   out.push_back(std::make_unique<devices::SerialProvider>(serialPorts));
+  out.push_back(std::make_unique<devices::MidiProvider>());
   out.push_back(std::make_unique<devices::V4l2Provider>());
   out.push_back(std::make_unique<devices::LibcameraProvider>());
   out.push_back(std::make_unique<sim::SyntheticProvider>());

@@ -28,7 +28,7 @@ namespace basalt::kiosk {
 [[nodiscard]] Result<devices::DeviceRequest> parseDeviceSpec(std::string_view text, devices::DeviceKind kind,
                                                              std::string name);
 
-/// \brief Every real backend (hid, serial, v4l2, libcamera) and the synthetic one.
+/// \brief Every real backend (hid, serial, midi, v4l2, libcamera) and the synthetic one.
 std::vector<std::unique_ptr<devices::DeviceProvider>> allProviders(const std::vector<std::string>& serialPorts = {});
 
 /// \brief The first id of the devices a run adds beside its show's: the show director's manager

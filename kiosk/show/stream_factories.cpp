@@ -14,6 +14,7 @@
 
 #include "devices/hid/hid_backend.h"
 #include "devices/libcamera/libcamera_camera.h"
+#include "devices/midi/midi_backend.h"
 #include "devices/serial/sgi_dial_box.h"
 #include "devices/v4l2/v4l2_camera.h"
 #include "media/frame_picker.h"
@@ -23,6 +24,7 @@
 #include "runtime/log.h"
 #include "runtime/test_pattern.h"
 #include "sim/hid_recording.h"
+#include "sim/midi_file.h"
 #include "sim/providers.h"
 
 namespace basalt::kiosk {
@@ -651,7 +653,8 @@ Result<devices::DeviceRequest> dialBoxRequest(const DeviceSpec& spec) {
   request.match = deviceMatchFor(spec);
   request.options["loop"] = spec.loop ? "true" : "false";
   std::error_code ec;
-  if (spec.backend == DeviceBackend::kReplay && std::filesystem::is_regular_file(spec.trace, ec)) {
+  if (spec.backend == DeviceBackend::kReplay && std::filesystem::is_regular_file(spec.trace, ec) &&
+      !sim::isMidiFilePath(spec.trace)) {
     // A hid-recorder file of several nodes (a tablet's pad and pen, a keydial's two interfaces):
     // the box plays the busiest one (its path in the replay is FILE#N).
     auto recording = sim::readHidRecording(spec.trace);
@@ -665,6 +668,8 @@ Result<devices::DeviceRequest> dialBoxRequest(const DeviceSpec& spec) {
   // The SGI box answers its reset within milliseconds; a retry with nothing on the port must not
   // hold the device thread for the backend's default second.
   if (spec.backend == DeviceBackend::kSerial) request.options["reset_timeout_ms"] = "200";
+  // A MIDI controller's profile and overrides, checked when the manifest was read.
+  for (const auto& [key, value] : spec.midi) request.options[key] = value;
   return request;
 }
 
@@ -700,6 +705,7 @@ devices::DeviceMatch deviceMatchFor(const DeviceSpec& spec) {
 Result<std::unique_ptr<devices::DeviceProvider>> providerFor(const DeviceSpec& spec) {
   switch (spec.backend) {
     case DeviceBackend::kHid: return std::make_unique<devices::HidProvider>();
+    case DeviceBackend::kMidi: return std::make_unique<devices::MidiProvider>();
     case DeviceBackend::kV4l2: return std::make_unique<devices::V4l2Provider>();
     case DeviceBackend::kLibcamera: return std::make_unique<devices::LibcameraProvider>();
     case DeviceBackend::kSynthetic: return std::make_unique<sim::SyntheticProvider>();

@@ -13,6 +13,11 @@
 //      under a ManualClock as fast as the headless frame loop runs (160x90 output, the default
 //      show), every new camera frame uploaded and drawn as in (b). Baseline: the same 3600
 //      frames with no devices. Target: at least 20x real time.
+//  (d) MIDI controller latency: from a Mackie V-Pot message sent on a sequencer port of the
+//      bench's own to the Show changed, through the kernel's sequencer, the midi backend's reader
+//      thread, the event queue's wake-up and LAVA's dial table; beside (a)'s SGI dial box on the
+//      same show, measured in the same run. Target: the change makes the next frame (under one
+//      frame interval, 16.7 ms at 60 fps). Needs ALSA's sequencer (snd-seq); skipped without it.
 
 #include <benchmark/benchmark.h>
 
@@ -29,8 +34,11 @@
 #include <thread>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "bench_main.h"
 #include "devices/hid/dial_decoder.h"
+#include "devices/midi/midi_backend.h"
 #include "devices/serial/sgi_dial_box.h"
 #include "kiosk/loop/frame_loop.h"
 #include "kiosk/show/device_wiring.h"
@@ -70,7 +78,7 @@ double median(std::vector<double> v) {
 }
 
 // Per-sample latencies: the machine is shared, so medians of samples, not means of batches.
-std::vector<double> floorSamples, dialSamples;
+std::vector<double> floorSamples, dialSamples, midiSamples, syntheticSamples;
 
 // (a) floor: bytes across the pty to a blocked reader.
 void dialFloor(benchmark::State& state) {
@@ -158,6 +166,77 @@ void dialToShow(benchmark::State& state) {
     dialSamples.push_back(done - sent.load());
   }
   box.close();
+}
+
+// (d) baseline: a dial event pushed into the queue by a device thread of its own (what a
+// synthetic or HID dial box's emit() does), to Show change on the same show.
+void syntheticToShow(benchmark::State& state) {
+  SystemClock clock;
+  auto loop = runtime::EventLoop::create(clock);
+  BoundedQueue<Event> events(1024, [l = loop->get()] { l->wake(); });
+  runtime::Show show = runtime::Show::makeDefault();
+  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  std::atomic<double> sent{0};
+  for (auto _ : state) {
+    std::thread device([&] {
+      std::this_thread::sleep_for(200us);
+      sent.store(nowSeconds());
+      (void)events.push(Event{clock.now(), 1, EventKind::kDialDelta, 0, 1.0 / 24});
+    });
+    bool changed = false;
+    while (!changed) {
+      if (!(*loop)->dispatch(Nanos{std::chrono::seconds(1)})) break;
+      Event e;
+      while (events.pop(e)) changed |= bindings.apply(e, show);
+    }
+    const double done = nowSeconds();
+    device.join();
+    state.SetIterationTime(done - sent.load());
+    syntheticSamples.push_back(done - sent.load());
+  }
+}
+
+// (d) a MIDI controller's message to Show change through ALSA's sequencer and the midi backend.
+void midiToShow(benchmark::State& state) {
+  auto port = devices::VirtualMidiPort::create("X-TOUCH MINI");
+  if (!port) {
+    state.SkipWithError(("no ALSA sequencer here: " + port.error().describe()).c_str());
+    return;
+  }
+  SystemClock clock;
+  auto loop = runtime::EventLoop::create(clock);
+  BoundedQueue<Event> events(1024, [l = loop->get()] { l->wake(); });
+  auto box = devices::openMidiDialBox((*port)->address(), {{"profile", "xtouch-mini-mc"}}, clock);
+  if (!box) {
+    state.SkipWithError(box.error().describe().c_str());
+    return;
+  }
+  if (auto opened = (*box)->open(1, events); !opened) {
+    state.SkipWithError(opened.error().describe().c_str());
+    return;
+  }
+  runtime::Show show = runtime::Show::makeDefault();
+  runtime::Bindings bindings = runtime::Bindings::lavaDefaults();
+  std::atomic<double> sent{0};
+  for (auto _ : state) {
+    std::thread writer([&] {
+      std::this_thread::sleep_for(200us);
+      const std::uint8_t msg[] = {0xB0, 0x10, 0x01};  // V-Pot 1 one detent clockwise
+      sent.store(nowSeconds());
+      (void)(*port)->send(msg);
+    });
+    bool changed = false;
+    while (!changed) {
+      if (!(*loop)->dispatch(Nanos{std::chrono::seconds(1)})) break;
+      Event e;
+      while (events.pop(e)) changed |= bindings.apply(e, show);
+    }
+    const double done = nowSeconds();
+    writer.join();
+    state.SetIterationTime(done - sent.load());
+    midiSamples.push_back(done - sent.load());
+  }
+  (*box)->close();
 }
 
 // (b) camera latency, measured inside one paced run.
@@ -412,6 +491,8 @@ void replaySpeed(benchmark::State& state) {
 
 BENCHMARK(dialFloor)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(50)->Repetitions(3);
 BENCHMARK(dialToShow)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(50)->Repetitions(3);
+BENCHMARK(syntheticToShow)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(50)->Repetitions(3);
+BENCHMARK(midiToShow)->UseManualTime()->Unit(benchmark::kMicrosecond)->Iterations(50)->Repetitions(3);
 BENCHMARK(cameraLatency)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(replaySpeed)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
 
@@ -429,6 +510,18 @@ int main(int argc, char** argv) {
           dial * 1e6, dialSamples.size(), floor * 1e6, floorSamples.size(), (dial - floor) * 1e6);
     } else {
       std::printf("devices: (a) no figure (no pseudo-terminals?)\n");
+    }
+    const double midi = median(midiSamples), synthetic = median(syntheticSamples);
+    if (midi >= 0 && synthetic >= 0) {
+      std::printf(
+          "devices: (d) MIDI controller latency, message sent to Show change: %.1f us (median of %zu); baseline, a "
+          "dial event from a device thread of its own on the same show: %.1f us (median of %zu)%s; target: the next "
+          "frame (< 16.7 ms at 60 fps): %s\n",
+          midi * 1e6, midiSamples.size(), synthetic * 1e6, syntheticSamples.size(),
+          dial >= 0 ? fmt::format(", the SGI dial box of (a): {:.1f} us", dial * 1e6).c_str() : "",
+          midi < 1.0 / 60 ? "met" : "NOT MET");
+    } else {
+      std::printf("devices: (d) no figure (no ALSA sequencer here: snd-seq; the virtual lab has it)\n");
     }
     const CameraFigures& c = cameraFigures;
     if (c.medianLatency >= 0) {

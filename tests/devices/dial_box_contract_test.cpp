@@ -27,6 +27,8 @@
 #include "devices/dial_box.h"
 #include "devices/hid/dial_decoder.h"
 #include "devices/hid/hid_backend.h"
+#include "devices/midi/midi_backend.h"
+#include "devices/midi/midi_decoder.h"
 #include "devices/serial/sgi_dial_box.h"
 #include "runtime/unique_fd.h"
 #include "sim/replay.h"
@@ -263,6 +265,27 @@ Made makePowerMateGadget(const Clock& clock, std::string& reason) {
   return {std::move(feeder), std::move(*box)};
 }
 
+/// An X-Touch Mini in MC mode played by a port of the test's own on ALSA's sequencer (the kernel's
+/// snd-seq): Basalt's MIDI backend subscribes to it through the kernel as to a USB controller.
+Made makeMidiSequencer(const Clock& clock, std::string& reason) {
+  auto port = VirtualMidiPort::create("X-TOUCH MINI");
+  if (!port) {
+    reason = "needs ALSA's sequencer (snd-seq, /dev/snd/seq; the virtual lab loads it): " + port.error().describe();
+    return {};
+  }
+  auto box = openMidiDialBox((*port)->address(), {{"profile", "xtouch-mini-mc"}}, clock);
+  if (!box) {
+    reason = box.error().describe();
+    return {};
+  }
+  std::shared_ptr<VirtualMidiPort> shared(std::move(*port));
+  auto feeder = std::make_unique<ThreadFeeder>([shared] {
+    const std::uint8_t turn[] = {0xB0, 0x10, 0x02};  // V-Pot 1 clockwise by 2 (sign-magnitude)
+    return static_cast<bool>(shared->send(turn));
+  });
+  return {std::move(feeder), std::move(*box)};
+}
+
 class DialBoxContract : public ::testing::TestWithParam<DialBackend> {
  protected:
   void SetUp() override {
@@ -363,14 +386,25 @@ TEST_P(DialBoxContract, RawReportsReachTheTapAndDecodeToTheSameEvents) {
   while (events.pop(e)) {
     if (e.kind == EventKind::kDialDelta || e.kind == EventKind::kButton) direct.push_back(e);
   }
-  auto decoder = DialDecoder::create(device().info().vendor, device().info().product, device().reportDescriptor());
-  ASSERT_TRUE(decoder) << decoder.error().describe();
   std::vector<Event> again;
   std::array<Event, DialDecoder::kMaxEventsPerReport> out;
   std::lock_guard lock(tap.mutex);
-  for (const auto& r : tap.reports) {
-    const std::size_t n = decoder->decode(r, out);
-    for (std::size_t i = 0; i < n; ++i) again.push_back(out[i]);
+  if (isMidiDescriptor(device().reportDescriptor())) {
+    // A MIDI dial box taps MIDI messages; its descriptor holds the profile that decodes them.
+    auto profile = parseMidiDescriptor(device().reportDescriptor());
+    ASSERT_TRUE(profile) << profile.error().describe();
+    MidiDecoder decoder(std::move(*profile));
+    for (const auto& r : tap.reports) {
+      const std::size_t n = decoder.decode(r, out);
+      for (std::size_t i = 0; i < n; ++i) again.push_back(out[i]);
+    }
+  } else {
+    auto decoder = DialDecoder::create(device().info().vendor, device().info().product, device().reportDescriptor());
+    ASSERT_TRUE(decoder) << decoder.error().describe();
+    for (const auto& r : tap.reports) {
+      const std::size_t n = decoder->decode(r, out);
+      for (std::size_t i = 0; i < n; ++i) again.push_back(out[i]);
+    }
   }
   ASSERT_FALSE(direct.empty());
   ASSERT_EQ(again.size(), direct.size()) << "recording the raw reports loses or invents events";
@@ -386,7 +420,8 @@ INSTANTIATE_TEST_SUITE_P(Backends, DialBoxContract,
                                            DialBackend{"serial_sgi_pty", makeSerialPty, true},
                                            DialBackend{"hid_gadget", makeHidGadget, true},
                                            DialBackend{"hid_uhid", makeUhid, true},
-                                           DialBackend{"powermate_gadget", makePowerMateGadget, true}),
+                                           DialBackend{"powermate_gadget", makePowerMateGadget, true},
+                                           DialBackend{"midi_sequencer", makeMidiSequencer, true}),
                          [](const ::testing::TestParamInfo<DialBackend>& param) { return param.param.name; });
 
 }  // namespace

@@ -479,7 +479,8 @@ TEST(ManifestErrors, DevicesAreCoherent) {
   EXPECT_TRUE(hasError(r, 9, "'77d:410' is not VVVV:PPPP")) << r.text;
   EXPECT_TRUE(hasError(r, 10, "the replay backend needs trace")) << r.text;
   EXPECT_TRUE(hasError(r, 16, "has no trace.toml")) << r.text;
-  EXPECT_TRUE(hasError(r, 19, "'bluetooth' is not one of hid, serial, v4l2, libcamera, replay or synthetic")) << r.text;
+  EXPECT_TRUE(hasError(r, 19, "'bluetooth' is not one of hid, serial, midi, v4l2, libcamera, replay or synthetic"))
+      << r.text;
   const auto ok = f.read("[devices.d]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"site.trace\"\n");
   ASSERT_TRUE(ok.manifest) << ok.text;
   EXPECT_EQ(ok.manifest->devices[0].trace, fs::canonical(f.dir / "site.trace"));
@@ -860,6 +861,53 @@ TEST(ManifestDevices, TheSerialBackendNeedsAPort) {
   EXPECT_TRUE(hasError(r, 1, "the serial backend needs the port: match = { path = \"/dev/ttyUSB0\" }")) << r.text;
   EXPECT_TRUE(hasError(r, 6, "a camera cannot use the serial backend")) << r.text;
   EXPECT_TRUE(hasError(r, 10, "'usb:1-2': the serial backend needs a /dev node")) << r.text;
+}
+
+// Makes sure a MIDI dial box's keys reach the backend as its options, and that what the backend
+// would refuse (an unknown profile, a channel out of range, a 14-bit dial above CC 31, a path
+// that is no sequencer port, MIDI keys on another backend) is named at its line by basalt check.
+// Example failure: a misspelt profile accepted, the controller then read with the generic map.
+TEST(ManifestDevices, MidiDialBoxesAndTheirOptions) {
+  ShowFolder f("midi");
+  const auto r = f.read(
+      "[devices.mini]\nkind = \"dial_box\"\nbackend = \"midi\"\nmatch = { name = \"X-TOUCH MINI\" }\n"
+      "midi = { profile = \"xtouch-mini-mc\", encoding = \"sign_magnitude\" }\n"
+      "[devices.any]\nkind = \"dial_box\"\nbackend = \"midi\"\n"
+      "midi = { channel = 2, dials = [16, 17, 18], notes = [36, 37], nrpn = [300], echo = true }\n");
+  ASSERT_TRUE(r.manifest) << r.text;
+  const DeviceSpec* mini = nullptr;
+  const DeviceSpec* any = nullptr;
+  for (const DeviceSpec& d : r.manifest->devices) {
+    if (d.name == "mini") mini = &d;
+    if (d.name == "any") any = &d;
+  }
+  ASSERT_TRUE(mini && any) << r.text;
+  EXPECT_EQ(mini->backend, DeviceBackend::kMidi);
+  EXPECT_EQ(mini->match.name, "X-TOUCH MINI");
+  EXPECT_EQ(mini->midi.at("profile"), "xtouch-mini-mc");
+  EXPECT_EQ(mini->midi.at("encoding"), "sign_magnitude");
+  EXPECT_EQ(any->midi.at("channel"), "2");
+  EXPECT_EQ(any->midi.at("dials"), "16,17,18");
+  EXPECT_EQ(any->midi.at("notes"), "36,37");
+  EXPECT_EQ(any->midi.at("nrpn"), "300");
+  EXPECT_EQ(any->midi.at("echo"), "true");
+}
+
+TEST(ManifestDevices, MidiOptionsTheBackendWouldRefuseAreNamed) {
+  ShowFolder f("midi-errors");
+  const auto r = f.read(
+      "[devices.bad]\nkind = \"dial_box\"\nbackend = \"midi\"\nmatch = { path = \"/dev/snd/midiC1D0\" }\n"  // 1-4
+      "midi = { profile = \"launchpad\" }\n"                                                                // 5
+      "[devices.wide]\nkind = \"dial_box\"\nbackend = \"midi\"\n"                                           // 6-8
+      "midi = { dials = [40], high_resolution = true, channel = 17 }\n"                                     // 9
+      "[devices.cam]\nkind = \"camera\"\nbackend = \"midi\"\n"                                              // 10-12
+      "[devices.hid]\nkind = \"dial_box\"\nbackend = \"hid\"\nmidi = { profile = \"midimix\" }\n");         // 13-16
+  EXPECT_TRUE(hasError(r, 4, "a MIDI port's path is seq:CLIENT:PORT")) << r.text;
+  EXPECT_TRUE(hasError(r, 5, "'launchpad' is not one of")) << r.text;
+  EXPECT_TRUE(hasError(r, 9, "17 is out of range")) << r.text;
+  EXPECT_TRUE(hasError(r, 9, "CC 40 cannot be a 14-bit MSB")) << r.text;
+  EXPECT_TRUE(hasError(r, 12, "a camera cannot use the midi backend")) << r.text;
+  EXPECT_TRUE(hasWarning(r, 16, "only the midi backend reads it")) << r.text;
 }
 
 TEST(ManifestDevices, TheSgiSerialBoxOpensOnItsPortAndTurnsItsDials) {

@@ -136,6 +136,17 @@ else
   fixture_fail alsa "modprobe snd_aloop failed or no Loopback card appeared"
 fi
 
+# ---- MIDI: ALSA's sequencer (the midi backend's contract case makes a port of its own on it),
+# its dummy "Midi Through" client and a snd-virmidi card whose rawmidi nodes are sequencer ports
+if load snd_seq && wait_for 5 test -c /dev/snd/seq; then
+  load snd_seq_dummy || true
+  load snd_virmidi || true
+  setenv BASALT_VLAB_MIDI_SEQ /dev/snd/seq
+  fixture_ok midi "snd-seq: /dev/snd/seq$(ls /dev/snd/midiC*D0 2>/dev/null | head -1 | sed 's/^/, virmidi /')"
+else
+  fixture_fail midi "modprobe snd_seq failed or no /dev/snd/seq appeared"
+fi
+
 # ---- uhid ---------------------------------------------------------------------------------
 if load uhid && wait_for 2 test -c /dev/uhid; then
   setenv BASALT_VLAB_UHID 1
