@@ -284,18 +284,22 @@ void OscInput::handle(std::span<const std::byte> bytes, const std::string& sende
   for (OscMessage& m : packet.messages) {
     m.sender = sender;
     OscRouted routed = router_.route(m, now);
-    for (ControlRequest& request : routed.controls) {
+    std::size_t pushed = 0;
+    for (std::size_t i = 0; i < routed.controls.size(); ++i) {
+      ControlRequest& request = routed.controls[i];
       auto reply = std::make_shared<ControlReply>();
       request.reply = reply;
       if (pending_.size() >= kMaxPending || !board_.controls().push(std::move(request))) {
-        router_.countQueueFull();
-        if (static log::Once full; full.first()) {
+        router_.countQueueFull(pushed == 0 && i + 1 == routed.controls.size());
+        static log::Once full;
+        if (full.first()) {
           log::warn(kLogOsc,
-                    "OSC: the controls' queue is full; OSC controls are dropped while it is (counted "
-                    "queue_full, said once)");
+                    "OSC: the controls' queue is full; OSC controls are dropped while it is (counted queue_full, "
+                    "said once)");
         }
         continue;
       }
+      ++pushed;
       pending_.push_back({std::move(reply), m.address, sender, now + kAnswerWait});
       woke = true;
     }

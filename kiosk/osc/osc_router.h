@@ -72,7 +72,11 @@ class OscRouter {
 
   /// \brief Counts packets the input could not take apart, and controls the queue refused.
   void countMalformed(std::size_t n) { figures_.malformed += n; }
-  void countQueueFull() { ++figures_.queueFull; }
+  /// `messageLost`: none of the message's controls got into the queue, so it did not act after all.
+  void countQueueFull(bool messageLost) {
+    ++figures_.queueFull;
+    if (messageLost && figures_.acted > 0) --figures_.acted;
+  }
   [[nodiscard]] const OscFigures& figures() const { return figures_; }
 
   /// \brief `value` read in `input` (clamped to it) and scaled into `range`; unchanged without a range.
