@@ -1190,5 +1190,27 @@ events = ["items"]
   EXPECT_TRUE(hasError(r, 62, "'items' is not one of item, devices or lock")) << r.text;
 }
 
+// Makes sure `basalt check` itself names the line of an OSC mistake and, for a good show, says
+// what OSC it sets up. Example failure: a wrong arity reported without its line, or a good show's
+// OSC bindings not mentioned, so the technician cannot tell they were read.
+TEST(ManifestOsc, BasaltCheckNamesTheLineAndTheBindings) {
+  ShowFolder f("osc-check");
+  writeFile(f.dir / "show.toml",
+            "[osc]\nlisten = \"127.0.0.1:9000\"\n\n[[osc.bind]]\naddress = \"/spin\"\n"
+            "action = \"rotate_y\"\ntypes = \"fs\"\n");
+  const auto bad = test::run({(test::binaryDir() / "basalt").string(), "check", (f.dir / "show.toml").string()});
+  EXPECT_NE(bad.exitCode, 0) << bad.output;
+  EXPECT_NE(bad.output.find("show.toml:7: error: osc.bind[0]: wrong arity: 'rotate_y' takes one number"),
+            std::string::npos)
+      << bad.output;
+  writeFile(f.dir / "show.toml",
+            "[osc]\nlisten = \"127.0.0.1:9000\"\n\n[[osc.bind]]\naddress = \"/spin\"\n"
+            "action = \"rotate_y\"\n\n[[osc.send]]\nto = \"127.0.0.1:9001\"\n");
+  const auto good = test::run({(test::binaryDir() / "basalt").string(), "check", (f.dir / "show.toml").string()});
+  EXPECT_EQ(good.exitCode, 0) << good.output;
+  EXPECT_NE(good.output.find("; OSC on 127.0.0.1:9000 with 1 binding and 1 destination"), std::string::npos)
+      << good.output;
+}
+
 }  // namespace
 }  // namespace basalt::kiosk
