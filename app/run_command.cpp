@@ -31,6 +31,8 @@
 #include "kiosk/loop/display_views.h"
 #include "kiosk/loop/frame_loop.h"
 #include "kiosk/manifest/manifest.h"
+#include "kiosk/osc/osc_input.h"
+#include "kiosk/osc/osc_output.h"
 #include "kiosk/policy/last_good.h"
 #include "kiosk/policy/state_store.h"
 #include "kiosk/policy/supervisor.h"
@@ -799,6 +801,7 @@ int runShow(const RunOptions& options) {
     const std::string error = loaded.error().describe();
     fmt::print(stderr, "basalt: error: cannot load the show: {}\n", error);
     const StatusSpec status = manifest.status;  // the manifest itself was good: its [status] holds
+    const OscSpec osc = manifest.osc;           // and so do its OSC bindings and destinations
     fallback = fallBack(options, {error});
     manifest = fallback->manifest;
     loaded = loadShow(manifest, clock, factories, false);
@@ -810,6 +813,7 @@ int runShow(const RunOptions& options) {
     }
     manifest.status = status;
     manifest.status.enabled = true;
+    manifest.osc = osc;
   }
   if (!loaded) return failWith(loaded.error(), "cannot load the show");
   if (fallback) board.setProblems(fallback->problems);
@@ -873,6 +877,30 @@ int runShow(const RunOptions& options) {
     } else {
       // The show matters more than its status page.
       log::error(kLogRun, "{}; the show plays without it", started.error().describe());
+    }
+  }
+
+  // [osc]: bindings from OSC addresses to the show's controls (through the board's control
+  // queue, as HTTP's), and the node's news to show controllers. The show plays without them when
+  // they cannot start.
+  std::unique_ptr<OscInput> oscInput;
+  std::unique_ptr<OscOutput> oscOutput;
+  if (manifest.osc.enabled) {
+    auto started = OscInput::start(manifest.osc, board);
+    if (started) {
+      oscInput = std::move(*started);
+      fmt::print("basalt: osc: {}\n", oscInput->describe());
+      std::fflush(stdout);
+    } else {
+      log::error(kLogRun, "{}; the show plays without OSC input", started.error().describe());
+    }
+    if (!manifest.osc.send.empty()) {
+      auto sending = OscOutput::start(manifest.osc.send, board);
+      if (sending) {
+        oscOutput = std::move(*sending);
+      } else {
+        log::error(kLogRun, "{}; the show plays without OSC output", sending.error().describe());
+      }
     }
   }
 
@@ -1060,6 +1088,8 @@ int runShow(const RunOptions& options) {
   }
   supervisor->stopping();
   server.reset();
+  oscInput.reset();
+  oscOutput.reset();
   if (!stats) return failWith(stats.error(), "the show stopped");
 
   if (options.saveModel) {

@@ -48,6 +48,27 @@ std::optional<Action> actionByName(std::string_view name) {
   return std::nullopt;
 }
 
+bool applyAction(Action action, float amount, Show& show) {
+  switch (action) {
+    case Action::kNone:
+    case Action::kMoveZoomX:
+    case Action::kMoveZoomY: return false;
+    case Action::kRotateX: show.rotateGlobal({amount, 0, 0}); return true;
+    case Action::kRotateY: show.rotateGlobal({0, amount, 0}); return true;
+    case Action::kRotateZ: show.rotateGlobal({0, 0, amount}); return true;
+    case Action::kScale: show.scaleGlobal(std::exp2(amount)); return true;
+    case Action::kTranslateX: show.translateGlobal({amount, 0, 0}); return true;
+    case Action::kTranslateY: show.translateGlobal({0, amount, 0}); return true;
+    case Action::kTranslateZ: show.translateGlobal({0, 0, amount}); return true;
+    case Action::kWalk: moveViewer(show, amount, 0, 0); return true;
+    case Action::kStrafe: moveViewer(show, 0, amount, 0); return true;
+    case Action::kRise: moveViewer(show, 0, 0, amount); return true;
+    case Action::kTurn: turnViewer(show, amount, 0); return true;
+    case Action::kTilt: turnViewer(show, 0, amount); return true;
+  }
+  return false;
+}
+
 Bindings Bindings::lavaDefaults() {
   Bindings b;
   b.setDial(0, {Action::kRotateX, 360});
@@ -88,23 +109,10 @@ bool Bindings::turn(std::size_t dial, double turns, Nanos time, Show& show, bool
   }
   const auto amount = static_cast<float>(turns * b.gain * gain_ * factor * (b.invert ? -1 : 1));
   switch (b.action) {
-    case Action::kNone: return false;
-    case Action::kRotateX: show.rotateGlobal({amount, 0, 0}); return true;
-    case Action::kRotateY: show.rotateGlobal({0, amount, 0}); return true;
-    case Action::kRotateZ: show.rotateGlobal({0, 0, amount}); return true;
-    case Action::kScale: show.scaleGlobal(std::exp2(amount)); return true;
-    case Action::kTranslateX: show.translateGlobal({amount, 0, 0}); return true;
-    case Action::kTranslateY: show.translateGlobal({0, amount, 0}); return true;
-    case Action::kTranslateZ: show.translateGlobal({0, 0, amount}); return true;
     case Action::kMoveZoomX: zoomMove_.dx += amount; return true;
     case Action::kMoveZoomY: zoomMove_.dy += amount; return true;
-    case Action::kWalk: moveViewer(show, amount, 0, 0); return true;
-    case Action::kStrafe: moveViewer(show, 0, amount, 0); return true;
-    case Action::kRise: moveViewer(show, 0, 0, amount); return true;
-    case Action::kTurn: turnViewer(show, amount, 0); return true;
-    case Action::kTilt: turnViewer(show, 0, amount); return true;
+    default: return applyAction(b.action, amount, show);
   }
-  return false;
 }
 
 bool Bindings::apply(const Event& event, Show& show) {

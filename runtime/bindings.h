@@ -46,6 +46,12 @@ std::string_view actionName(Action action);
 /// \brief The action named `name`, or nullopt.
 std::optional<Action> actionByName(std::string_view name);
 
+/// \brief Applies `amount` of `action` to the show at once, in the units a dial's gain gives
+/// per turn (degrees for rotations and turns, a factor of 2^amount for scaling, window or scene
+/// units for moves). The Zoom moves and kNone change nothing here (false); everything else
+/// returns true. Controls that are not dials (OSC) act through this, as the dials do.
+bool applyAction(Action action, float amount, Show& show);
+
 /// \brief What one dial does, and how much per turn: degrees for rotations, a factor of 2^gain
 /// for scaling, window units for translations.
 struct DialBinding {

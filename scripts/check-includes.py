@@ -24,7 +24,8 @@ ALLOWED = {
     "kiosk/lock": LOWER + ["kiosk/manifest", "kiosk/loop"],
     "kiosk/policy": LOWER + ["kiosk/manifest", "kiosk/loop"],
     "kiosk/status": LOWER + ["kiosk/manifest", "kiosk/loop", "kiosk/lock", "kiosk/policy"],
-    "kiosk/show": LOWER + ["kiosk/manifest", "kiosk/loop", "kiosk/lock", "kiosk/policy", "kiosk/status"],
+    "kiosk/osc": LOWER + ["kiosk/manifest", "kiosk/loop", "kiosk/lock", "kiosk/policy", "kiosk/status"],
+    "kiosk/show": LOWER + ["kiosk/manifest", "kiosk/loop", "kiosk/lock", "kiosk/policy", "kiosk/status", "kiosk/osc"],
     "app": LOWER + ["kiosk"],
     "tools/vlab": ["sim", "devices", "runtime"],
 }
@@ -32,6 +33,7 @@ ALLOWED = {
 LIBRARIES = [
     (re.compile(r"^(zmq\.h|zmq\.hpp)$"), "ZeroMQ", "kiosk/lock"),
     (re.compile(r"^httplib\.h$"), "cpp-httplib", "kiosk/status"),
+    (re.compile(r"^lo/"), "liblo", "kiosk/osc"),
     (re.compile(r"^systemd/"), "libsystemd", "kiosk/policy"),
     (re.compile(r"^toml\+\+/"), "toml++", "kiosk/manifest"),
     (re.compile(r"^cctz/"), "cctz", "kiosk/manifest"),

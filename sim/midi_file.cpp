@@ -1,7 +1,7 @@
 // Standard MIDI Files (the MIDI Manufacturers Association's SMF 1.0): Basalt's writer and reader.
 // No Debian library fits: libportsmf reads into Allegro sequences with times as doubles in
 // beats (not exact), and pulls in a library for a format of a few hundred lines
-// (docs/decisions/XXXX-midi-through-alsa.md).
+// (docs/decisions/0064-midi-through-alsa.md).
 
 #include "sim/midi_file.h"
 

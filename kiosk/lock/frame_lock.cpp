@@ -11,7 +11,7 @@
 // derived from the group's shared secret with libsodium (BLAKE2b, then X25519), so one file
 // on every node is the whole configuration. A ZAP handler on the leader admits only clients
 // with the group's public key; a socket monitor counts the handshakes that fail (no key, another
-// key, a replayed capture). See docs/decisions/XXXX-frame-lock-curve.md.
+// key, a replayed capture). See docs/decisions/0060-frame-lock-curve.md.
 
 #include "kiosk/lock/frame_lock.h"
 

@@ -43,6 +43,12 @@ CheckResult checkManifestFile(const std::filesystem::path& file) {
       manifest->entry.kind == EntryKind::kBuiltinDefault ? std::string("the default show") : manifest->entry.text,
       manifest->devices.size(), manifest->devices.size() == 1 ? "" : "s", manifest->media.size(),
       manifest->bindings.size(), manifest->bindings.size() == 1 ? "" : "s");
+  if (const OscSpec& osc = manifest->osc; osc.enabled) {
+    // Said only where there is OSC, so that the line of every other show stays as it was.
+    result.verdict +=
+        fmt::format("; OSC on {}:{} with {} binding{} and {} destination{}", osc.host, osc.port, osc.bindings.size(),
+                    osc.bindings.size() == 1 ? "" : "s", osc.send.size(), osc.send.size() == 1 ? "" : "s");
+  }
   return result;
 }
 

@@ -21,6 +21,7 @@
 #include <tuple>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <fmt/std.h>
 
 #include "devices/midi/midi_decoder.h"
@@ -127,6 +128,8 @@ bool loopbackHost(std::string_view host) { return host == "localhost" || host ==
 }  // namespace
 
 bool StatusSpec::loopbackOnly() const { return loopbackHost(host); }
+
+bool OscSpec::loopbackOnly() const { return loopbackHost(host); }
 
 Result<std::string> readLockKey(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -704,9 +707,9 @@ class Reader {
     manifest_.name = manifest_.folder.filename().string();
     manifest_.entry = {EntryKind::kBuiltinDefault, "default", {}, 0};
 
-    checkKeys(
-        root, "",
-        {"show", "output", "views", "media", "devices", "bindings", "textures", "kiosk", "status", "input", "lock"});
+    checkKeys(root, "",
+              {"show", "output", "views", "media", "devices", "bindings", "textures", "kiosk", "status", "input",
+               "lock", "osc"});
     if (const toml::table* t = table(root, "show", "")) readShow(*t);
     if (const toml::table* t = table(root, "output", "")) readOutput(*t);
     readViews(root);
@@ -719,6 +722,7 @@ class Reader {
     if (const toml::table* t = table(root, "status", "")) readStatus(*t);
     if (const toml::table* t = table(root, "input", "")) readInput(*t);
     if (const toml::table* t = table(root, "lock", "")) readLock(*t);
+    if (const toml::table* t = table(root, "osc", "")) readOsc(*t);
 
     // By line, keeping the order of problems found on the same line.
     std::vector<std::size_t> order(diagsOwn_.size());
@@ -2177,6 +2181,424 @@ class Reader {
                                 file, p.string()));
     }
     if (auto key = readLockKey(p); !key) error(line, fmt::format("lock.key_file: {}", key.error().message()));
+  }
+
+  // ---- [osc] ----
+  /// "HOST:PORT" or "[V6]:PORT" into its parts; an empty string, or why it is not one.
+  static std::string splitHostPort(std::string_view text, std::string& host, int& port) {
+    std::string_view h = text;
+    std::string_view p;
+    if (text.starts_with('[')) {
+      const auto close = text.find(']');
+      if (close == std::string_view::npos || close + 1 >= text.size() || text[close + 1] != ':') {
+        return fmt::format("'{}' is not [ADDRESS]:PORT", text);
+      }
+      h = text.substr(1, close - 1);
+      p = text.substr(close + 2);
+    } else if (const auto colon = text.rfind(':'); colon != std::string_view::npos) {
+      h = text.substr(0, colon);
+      p = text.substr(colon + 1);
+    } else {
+      return fmt::format("'{}' needs a port: ADDRESS:PORT", text);
+    }
+    if (!parseUnsigned(p, port) || port < 0 || port > 65535) return fmt::format("port '{}' is not 0 to 65535", p);
+    if (h.empty()) return fmt::format("'{}' needs an address before the port", text);
+    host = std::string(h);
+    return {};
+  }
+
+  static bool numericAddress(const std::string& text) {
+    in6_addr v6{};
+    in_addr v4{};
+    return ::inet_pton(AF_INET, text.c_str(), &v4) == 1 || ::inet_pton(AF_INET6, text.c_str(), &v6) == 1;
+  }
+
+  void readOsc(const toml::table& t) {
+    OscSpec& o = manifest_.osc;
+    o.enabled = true;
+    o.line = lineOf(t);
+    o.messagesPerSecond = manifest_.status.requestsPerSecond;  // the same limit as the HTTP controls
+    checkKeys(t, "osc", {"enabled", "listen", "protocols", "allow", "messages_per_second", "bind", "send"});
+    if (auto enabled = boolean(t, "enabled", "osc")) o.enabled = *enabled;
+    if (auto listen = string(t, "listen", "osc")) {
+      int port = 0;
+      if (auto why = splitHostPort(*listen, o.host, port); !why.empty()) {
+        error(lineOf(*t.get("listen")), fmt::format("osc.listen: {}; e.g. 127.0.0.1:9000", why));
+      } else if (!numericAddress(o.host) && o.host != "localhost") {
+        error(lineOf(*t.get("listen")),
+              fmt::format("osc.listen: '{}' is not an address of this machine (127.0.0.1, 0.0.0.0, ::, ...)", o.host));
+      } else {
+        o.port = static_cast<std::uint16_t>(port);
+      }
+    }
+    if (const toml::node* node = t.get("protocols")) {
+      const toml::array* a = node->as_array();
+      if (!a || a->empty()) {
+        error(lineOf(*node), "osc.protocols: must be a list of \"udp\" and \"tcp\"");
+      } else {
+        o.udp = o.tcp = false;
+        for (const toml::node& p : *a) {
+          const auto* name = p.as_string();
+          if (name && name->get() == "udp") {
+            o.udp = true;
+          } else if (name && name->get() == "tcp") {
+            o.tcp = true;
+          } else {
+            error(lineOf(p), "osc.protocols: each is \"udp\" or \"tcp\"");
+          }
+        }
+      }
+    }
+    if (const toml::node* node = t.get("allow")) {
+      const toml::array* a = node->as_array();
+      if (!a) {
+        error(lineOf(*node), "osc.allow: must be a list of senders' addresses, e.g. [\"127.0.0.1\", \"10.0.0.5\"]");
+      } else {
+        for (const toml::node& p : *a) {
+          const auto* address = p.as_string();
+          if (!address || !numericAddress(address->get())) {
+            error(lineOf(p), fmt::format("osc.allow: '{}' is not an IPv4 or IPv6 address",
+                                         address ? address->get() : std::string(typeName(p))));
+            continue;
+          }
+          o.allow.push_back(address->get());
+        }
+      }
+    }
+    if (auto rate = number(t, "messages_per_second", "osc", 1, 10000)) o.messagesPerSecond = *rate;
+    if (o.enabled && !o.loopbackOnly() && o.allow.empty()) {
+      warning(t.get("listen") ? lineOf(*t.get("listen")) : o.line,
+              fmt::format("osc.listen: '{}' lets any machine that reaches port {} drive the show; list the senders "
+                          "in osc.allow",
+                          o.host, o.port));
+    }
+    if (const toml::node* node = t.get("bind")) {
+      const toml::array* a = node->as_array();
+      if (!a) {
+        error(lineOf(*node), "osc.bind: must be an array of tables ([[osc.bind]])");
+      } else {
+        std::set<std::string> seen;
+        std::size_t index = 0;
+        for (const toml::node& item : *a) {
+          const std::string path = fmt::format("osc.bind[{}]", index++);
+          const toml::table* b = item.as_table();
+          if (!b) {
+            error(lineOf(item), fmt::format("{}: must be a table", path));
+            continue;
+          }
+          if (auto spec = readOscBinding(*b, path)) {
+            if (!seen.insert(spec->address).second) {
+              error(spec->line, fmt::format("{}.address: '{}' is already bound", path, spec->address));
+              continue;
+            }
+            o.bindings.push_back(std::move(*spec));
+          }
+        }
+      }
+    }
+    if (const toml::node* node = t.get("send")) {
+      const toml::array* a = node->as_array();
+      if (!a) {
+        error(lineOf(*node), "osc.send: must be an array of tables ([[osc.send]])");
+      } else {
+        std::size_t index = 0;
+        for (const toml::node& item : *a) {
+          const std::string path = fmt::format("osc.send[{}]", index++);
+          const toml::table* d = item.as_table();
+          if (!d) {
+            error(lineOf(item), fmt::format("{}: must be a table", path));
+            continue;
+          }
+          if (auto spec = readOscSend(*d, path)) o.send.push_back(std::move(*spec));
+        }
+      }
+    }
+  }
+
+  /// Why `address` cannot be an OSC method's address, or "".
+  static std::string oscAddressProblem(std::string_view address) {
+    if (!address.starts_with('/')) return "must start with '/'";
+    if (address.size() > kOscMaxAddressBytes) return fmt::format("is longer than {} bytes", kOscMaxAddressBytes);
+    if (address.ends_with('/')) return "must not end with '/'";
+    for (const char c : address) {
+      if (c <= ' ' || c > '~' || c == '#' || c == ',')
+        return "may hold only printable characters, no space, '#' or ','";
+      if (std::string_view("?*[]{}").find(c) != std::string_view::npos) {
+        return fmt::format("holds '{}', which OSC keeps for patterns a sender matches against", c);
+      }
+    }
+    if (address.find("//") != std::string_view::npos) return "has an empty part ('//')";
+    return {};
+  }
+
+  std::optional<std::array<double, 2>> pair(const toml::table& t, std::string_view name, const std::string& path) {
+    const toml::node* node = t.get(name);
+    if (!node) return std::nullopt;
+    const toml::array* a = node->as_array();
+    std::array<double, 2> out{};
+    if (a && a->size() == 2) {
+      for (std::size_t i = 0; i < 2; ++i) {
+        const toml::node& v = (*a)[i];
+        if (const auto* n = v.as_integer()) {
+          out[i] = static_cast<double>(n->get());
+        } else if (const auto* f = v.as_floating_point(); f && std::isfinite(f->get())) {
+          out[i] = f->get();
+        } else {
+          a = nullptr;
+          break;
+        }
+      }
+    } else {
+      a = nullptr;
+    }
+    if (!a) {
+      error(lineOf(*node), fmt::format("{}.{}: must be two numbers, [LOW, HIGH]", path, name));
+      return std::nullopt;
+    }
+    return out;
+  }
+
+  std::optional<OscBindingSpec> readOscBinding(const toml::table& t, const std::string& path) {
+    OscBindingSpec b;
+    b.line = lineOf(t);
+    checkKeys(t, path, {"address", "action", "command", "types", "input", "range", "mode"});
+    bool ok = true;
+    if (auto address = string(t, "address", path)) {
+      if (auto why = oscAddressProblem(*address); !why.empty()) {
+        error(lineOf(*t.get("address")), fmt::format("{}.address: '{}' {}", path, *address, why));
+        ok = false;
+      } else if (address->starts_with("/tracker/")) {
+        error(lineOf(*t.get("address")),
+              fmt::format("{}.address: '{}': addresses under /tracker/ are kept for tracker devices", path, *address));
+        ok = false;
+      }
+      b.address = *address;
+    } else {
+      if (!t.get("address")) error(b.line, fmt::format("{}: needs address = \"/...\"", path));
+      ok = false;
+    }
+    const toml::node* actionNode = t.get("action");
+    auto action = string(t, "action", path);
+    if (!action) {
+      if (!actionNode) error(b.line, fmt::format("{}: needs action = \"...\"", path));
+      return std::nullopt;
+    }
+    static constexpr std::array<std::pair<std::string_view, OscDo>, 5> kControls{{{"next", OscDo::kNext},
+                                                                                  {"previous", OscDo::kPrevious},
+                                                                                  {"reload", OscDo::kReload},
+                                                                                  {"reset_view", OscDo::kResetView},
+                                                                                  {"command", OscDo::kCommand}}};
+    bool known = false;
+    for (const auto& [name, what] : kControls) {
+      if (*action == name) b.what = what, known = true;
+    }
+    if (!known) {
+      const auto dial = runtime::actionByName(*action);
+      if (dial && *dial != runtime::Action::kNone && *dial != runtime::Action::kMoveZoomX &&
+          *dial != runtime::Action::kMoveZoomY) {
+        b.what = OscDo::kDial;
+        b.action = *dial;
+        known = true;
+      }
+    }
+    if (!known) {
+      static constexpr std::array<std::string_view, 18> kNames{
+          "rotate_x", "rotate_y", "rotate_z", "scale", "translate_x", "translate_y", "translate_z", "walk",    "strafe",
+          "rise",     "turn",     "tilt",     "next",  "previous",    "reload",      "reset_view",  "command", ""};
+      std::string_view best;
+      std::size_t bestDistance = 3;
+      for (const std::string_view n : kNames) {
+        if (n.empty()) continue;
+        if (const std::size_t d = editDistance(*action, n); d < bestDistance) bestDistance = d, best = n;
+      }
+      error(lineOf(*actionNode),
+            fmt::format("{}.action: unknown action '{}'{}; OSC bindings take rotate_x, rotate_y, rotate_z, scale, "
+                        "translate_x, translate_y, translate_z, walk, strafe, rise, turn, tilt, next, previous, "
+                        "reload, reset_view or command",
+                        path, *action, best.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", best)));
+      return std::nullopt;
+    }
+    // The command and its placeholders $1..$8.
+    std::size_t highest = 0;
+    std::set<std::size_t> used;
+    if (auto command = string(t, "command", path)) {
+      if (b.what != OscDo::kCommand) {
+        error(lineOf(*t.get("command")), fmt::format("{}.command: only action = \"command\" runs a command", path));
+        ok = false;
+      }
+      b.command = *command;
+      for (std::size_t i = 0; i + 1 < command->size(); ++i) {
+        if ((*command)[i] == '$' && std::isdigit(static_cast<unsigned char>((*command)[i + 1]))) {
+          const std::size_t n = static_cast<std::size_t>((*command)[i + 1] - '0');
+          if (n == 0 || n > kOscMaxArguments ||
+              (i + 2 < command->size() && std::isdigit(static_cast<unsigned char>((*command)[i + 2])))) {
+            error(lineOf(*t.get("command")),
+                  fmt::format("{}.command: placeholders are $1 to ${}", path, kOscMaxArguments));
+            ok = false;
+            break;
+          }
+          used.insert(n);
+          highest = std::max(highest, n);
+        }
+      }
+      if (command->empty() || command->find('\n') != std::string::npos) {
+        error(lineOf(*t.get("command")), fmt::format("{}.command: must be one LAVA script command", path));
+        ok = false;
+      }
+      if (command->size() > 1024) {
+        error(lineOf(*t.get("command")), fmt::format("{}.command: a command is at most 1024 bytes", path));
+        ok = false;
+      }
+    } else if (b.what == OscDo::kCommand && !t.get("command")) {
+      error(b.line, fmt::format("{}: action = \"command\" needs command = \"...\" (a LAVA script command; $1, $2 "
+                                "... stand for the message's arguments)",
+                                path));
+      ok = false;
+    }
+    // The types, and their number against what the action takes.
+    switch (b.what) {
+      case OscDo::kDial: b.types = "f"; break;
+      case OscDo::kCommand: b.types = std::string(highest, 'f'); break;
+      default: b.types = ""; break;
+    }
+    const toml::node* typesNode = t.get("types");
+    if (auto types = string(t, "types", path)) {
+      b.types = *types;
+      if (types->size() > kOscMaxArguments || types->find_first_not_of("fs") != std::string::npos) {
+        error(lineOf(*typesNode), fmt::format("{}.types: '{}' must be at most {} of 'f' (a number) and 's' (a string)",
+                                              path, *types, kOscMaxArguments));
+        ok = false;
+      }
+    }
+    const int typesLine = typesNode ? lineOf(*typesNode) : b.line;
+    const std::string_view actionText = *action;
+    if (b.what == OscDo::kDial && b.types != "f") {
+      error(typesLine, fmt::format("{}: wrong arity: '{}' takes one number (types = \"f\"), not \"{}\"", path,
+                                   actionText, b.types));
+      ok = false;
+    } else if ((b.what == OscDo::kNext || b.what == OscDo::kPrevious || b.what == OscDo::kReload ||
+                b.what == OscDo::kResetView) &&
+               !b.types.empty() && b.types != "f") {
+      error(typesLine, fmt::format("{}: wrong arity: '{}' takes no argument, or one number (types = \"f\": a button, "
+                                   "acting when it is 0.5 or more), not \"{}\"",
+                                   path, actionText, b.types));
+      ok = false;
+    } else if (b.what == OscDo::kCommand && !b.types.empty()) {
+      for (std::size_t n = 1; n <= b.types.size(); ++n) {
+        if (!used.contains(n)) {
+          error(typesLine, fmt::format("{}: wrong arity: types = \"{}\" gives {} arguments, but the command has no "
+                                       "${}",
+                                       path, b.types, b.types.size(), n));
+          ok = false;
+          break;
+        }
+      }
+    }
+    if (b.what == OscDo::kCommand && highest > b.types.size()) {
+      error(typesLine, fmt::format("{}: wrong arity: the command uses ${}, but types = \"{}\" gives {} argument{}",
+                                   path, highest, b.types, b.types.size(), b.types.size() == 1 ? "" : "s"));
+      ok = false;
+    }
+    const bool numbers = b.types.find('f') != std::string::npos;
+    if (auto input = pair(t, "input", path)) {
+      if ((*input)[0] == (*input)[1]) {
+        error(lineOf(*t.get("input")), fmt::format("{}.input: LOW and HIGH must differ", path));
+        ok = false;
+      }
+      b.input = *input;
+    }
+    if (auto range = pair(t, "range", path)) b.range = *range;
+    if (!numbers && (t.get("input") || t.get("range"))) {
+      warning(lineOf(*t.get(t.get("input") ? "input" : "range")),
+              fmt::format("{}: no argument is a number, so input and range scale nothing", path));
+    }
+    if (auto mode = choice<bool>(t, "mode", path, {{"relative", false}, {"absolute", true}})) {
+      b.absolute = *mode;
+      if (b.what != OscDo::kDial) {
+        warning(lineOf(*t.get("mode")), fmt::format("{}.mode: only dial actions move by a change", path));
+      }
+    }
+    if (b.what == OscDo::kDial && !b.range) b.range = std::array<double, 2>{0, defaultGain(b.action)};
+    if (!ok) return std::nullopt;
+    return b;
+  }
+
+  std::optional<OscSendSpec> readOscSend(const toml::table& t, const std::string& path) {
+    OscSendSpec d;
+    d.line = lineOf(t);
+    checkKeys(t, path, {"to", "protocol", "prefix", "events", "figures", "rate"});
+    bool ok = true;
+    if (auto to = string(t, "to", path)) {
+      int port = 0;
+      if (auto why = splitHostPort(*to, d.host, port); !why.empty()) {
+        error(lineOf(*t.get("to")), fmt::format("{}.to: {}; e.g. \"127.0.0.1:9001\"", path, why));
+        ok = false;
+      } else if (port == 0) {
+        error(lineOf(*t.get("to")), fmt::format("{}.to: port 0 is no destination; give the port that listens", path));
+        ok = false;
+      } else {
+        d.port = static_cast<std::uint16_t>(port);
+      }
+    } else {
+      if (!t.get("to")) error(d.line, fmt::format("{}: needs to = \"HOST:PORT\"", path));
+      ok = false;
+    }
+    if (auto tcp = choice<bool>(t, "protocol", path, {{"udp", false}, {"tcp", true}})) d.tcp = *tcp;
+    if (auto prefix = string(t, "prefix", path)) {
+      if (auto why = oscAddressProblem(*prefix); !why.empty()) {
+        error(lineOf(*t.get("prefix")), fmt::format("{}.prefix: '{}' {}", path, *prefix, why));
+        ok = false;
+      }
+      d.prefix = *prefix;
+    }
+    if (const toml::node* node = t.get("events")) {
+      const toml::array* a = node->as_array();
+      if (!a) {
+        error(lineOf(*node), fmt::format("{}.events: must be a list of \"item\", \"devices\" and \"lock\"", path));
+        ok = false;
+      } else {
+        d.item = d.devices = d.lock = false;
+        for (const toml::node& e : *a) {
+          const auto* name = e.as_string();
+          const std::string text = name ? name->get() : std::string();
+          if (text == "item") {
+            d.item = true;
+          } else if (text == "devices") {
+            d.devices = true;
+          } else if (text == "lock") {
+            d.lock = true;
+          } else {
+            error(lineOf(e), fmt::format("{}.events: '{}' is not one of item, devices or lock", path, text));
+            ok = false;
+          }
+        }
+      }
+    }
+    if (const toml::node* node = t.get("figures")) {
+      const toml::array* a = node->as_array();
+      if (!a) {
+        error(lineOf(*node), fmt::format("{}.figures: must be a list of names", path));
+        ok = false;
+      } else {
+        for (const toml::node& e : *a) {
+          const auto* name = e.as_string();
+          const std::string text = name ? name->get() : std::string();
+          if (std::ranges::find(kOscFigureNames, text) == kOscFigureNames.end()) {
+            error(lineOf(e),
+                  fmt::format("{}.figures: '{}' is not one of {}", path, text, fmt::join(kOscFigureNames, ", ")));
+            ok = false;
+            continue;
+          }
+          d.figures.push_back(text);
+        }
+      }
+    }
+    if (auto rate = number(t, "rate", path, 0.1, 60)) d.rate = *rate;
+    if (t.get("rate") && d.figures.empty()) {
+      warning(lineOf(*t.get("rate")), fmt::format("{}.rate: no figures to send at this rate", path));
+    }
+    if (!ok) return std::nullopt;
+    return d;
   }
 
   // ---- [status] ----

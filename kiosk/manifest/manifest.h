@@ -375,6 +375,67 @@ struct LockSpec {
   [[nodiscard]] bool loopbackOnly() const;
 };
 
+/// \brief What an `[[osc.bind]]` does: a dial's action (`action` of runtime::Action), a kiosk
+/// control, or one LAVA script command made from `command` and the message's arguments.
+enum class OscDo : std::uint8_t { kDial, kNext, kPrevious, kReload, kResetView, kCommand };
+
+/// \brief The most arguments an OSC binding takes (`types`), and the longest address.
+inline constexpr std::size_t kOscMaxArguments = 8;
+inline constexpr std::size_t kOscMaxAddressBytes = 256;
+
+/// \brief `[[osc.bind]]`: one OSC address and what a message to it does.
+struct OscBindingSpec {
+  std::string address;  ///< "/basalt/rotate_y": an OSC address without wildcards
+  OscDo what = OscDo::kDial;
+  runtime::Action action = runtime::Action::kNone;  ///< kDial
+  std::string command;                              ///< kCommand: a LAVA command with $1..$8 for the arguments
+  /// The argument types a message must carry: 'f' a number (OSC i, h, f, d), 's' a string (s, S).
+  std::string types;
+  /// Numbers in `input` (clamped to it) are scaled linearly into `range`; without `range` they
+  /// pass unchanged (commands) or one `input` is a turn of the dial (dial actions).
+  std::array<double, 2> input{0, 1};
+  std::optional<std::array<double, 2>> range;
+  /// Dial actions: a number moves by its value (false), or is a position and moves by its
+  /// change since the previous message (true: a fader; the first message sets the start).
+  bool absolute = false;
+  int line = 0;
+};
+
+/// \brief `[[osc.send]]`: a destination that follows the node over OSC.
+struct OscSendSpec {
+  std::string host;
+  std::uint16_t port = 0;
+  bool tcp = false;
+  std::string prefix = "/basalt";
+  bool item = true;     ///< PREFIX/item ,sii name index count when an item starts
+  bool devices = true;  ///< PREFIX/device ,ss name state when a device is lost or back
+  bool lock = true;     ///< PREFIX/lock ,si state followers when the frame-lock state changes
+  /// Figures sent every 1/rate s, each as PREFIX/NAME with one number (kOscFigureNames).
+  std::vector<std::string> figures;
+  double rate = 1;
+  int line = 0;
+};
+
+/// \brief The figures `[[osc.send]] figures` may name.
+inline constexpr std::array<std::string_view, 8> kOscFigureNames{
+    "fps", "frames", "late_frames", "dropped_frames", "input_dropped", "work_ms", "frame_ms", "osc_refused"};
+
+/// \brief `[osc]`: OSC input (bindings) and output (destinations).
+struct OscSpec {
+  bool enabled = false;
+  std::string host = "127.0.0.1";
+  std::uint16_t port = 9000;
+  bool udp = true;
+  bool tcp = true;
+  std::vector<std::string> allow;  ///< senders' addresses; empty: any sender that reaches the port
+  double messagesPerSecond = 20;   ///< per sender, bursts of twice that (as [status] requests)
+  std::vector<OscBindingSpec> bindings;
+  std::vector<OscSendSpec> send;
+  int line = 0;
+  /// \brief True when `host` is a loopback address.
+  [[nodiscard]] bool loopbackOnly() const;
+};
+
 /// \brief A whole show manifest, validated.
 struct Manifest {
   std::filesystem::path file;    ///< absolute path of show.toml
@@ -392,6 +453,7 @@ struct Manifest {
   StatusSpec status;
   InputSpec input;
   LockSpec lock;
+  OscSpec osc;
 
   /// \brief A manifest for the built-in default show: no file, every default.
   static Manifest builtinDefault();

@@ -367,6 +367,27 @@ void ShowDirector::handleControls(const FrameContext& frame) {
         }
         break;
       }
+      case ControlKind::kAction:
+      case ControlKind::kResetView: {
+        if (follower_) {
+          // The leader's show is the group's: a move here alone would part this node's picture.
+          reply.answer(409,
+                       "this node follows its frame-lock leader, whose show every node draws: send the control to "
+                       "the leader");
+          break;
+        }
+        // A visitor's move (OSC from a show controller or a fader) counts as activity, as a dial's.
+        if (policy_->noteInput(now)) applyProgramme(now);
+        if (request.kind == ControlKind::kResetView) {
+          context_.show.resetTransforms();
+          reply.answer(200, "view reset");
+        } else if (runtime::applyAction(request.action, request.amount, context_.show)) {
+          reply.answer(200, fmt::format("{} {}", runtime::actionName(request.action), request.amount));
+        } else {
+          reply.answer(400, fmt::format("'{}' does not move the show", runtime::actionName(request.action)));
+        }
+        break;
+      }
       case ControlKind::kCalibrate: {
         if (!views_) {
           reply.answer(409, "this show has no facet views to calibrate (add [[views]] with kind = \"facet\")");

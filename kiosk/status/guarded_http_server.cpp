@@ -4,7 +4,7 @@
 // bodies, so one slow or endless client holds a thread for as long as it likes. Here a
 // connection is admitted (per-client and total limits, a descriptor budget), its request is read
 // whole by one reception thread that polls every waiting connection, and only a whole request
-// reaches a worker. Decision: docs/decisions/XXXX-status-server-connections-handled-by-basalt.md.
+// reaches a worker. Decision: docs/decisions/0059-status-server-connections-handled-by-basalt.md.
 
 #include "kiosk/status/guarded_http_server.h"
 

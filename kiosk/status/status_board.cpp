@@ -101,6 +101,42 @@ void StatusBoard::publishPerformance(const runtime::PerformanceMeter& meter) {
   performance_ = meter;
 }
 
+void StatusBoard::publishOsc(const OscFigures& figures) {
+  std::lock_guard lock(mutex_);
+  const std::uint64_t sent = osc_ ? osc_->sent : 0;
+  const std::uint64_t failed = osc_ ? osc_->sendFailed : 0;
+  osc_ = figures;
+  osc_->sent = sent;
+  osc_->sendFailed = failed;
+}
+
+void StatusBoard::publishOscSent(std::uint64_t sent, std::uint64_t failed) {
+  std::lock_guard lock(mutex_);
+  if (!osc_) osc_.emplace();
+  osc_->sent = sent;
+  osc_->sendFailed = failed;
+}
+
+ShowStatus StatusBoard::showStatus() const {
+  std::lock_guard lock(mutex_);
+  return show_;
+}
+
+std::vector<DeviceStatus> StatusBoard::deviceStatus() const {
+  std::lock_guard lock(mutex_);
+  return devices_;
+}
+
+std::optional<OscFigures> StatusBoard::oscFigures() const {
+  std::lock_guard lock(mutex_);
+  return osc_;
+}
+
+std::optional<FrameLockFigures> StatusBoard::lockFigures() const {
+  std::lock_guard lock(mutex_);
+  return lock_;
+}
+
 void StatusBoard::publishLock(const FrameLockFigures& figures) {
   std::lock_guard lock(mutex_);
   lock_ = figures;
@@ -248,6 +284,7 @@ StatusSnapshot StatusBoard::snapshot(WallTime now) const {
     }
     s.performance = performance_;
     s.lock = lock_;
+    s.osc = osc_;
   }
   if (s.show.schedule)
     s.show.nextScheduleChange = s.show.schedule->nextChange(showClock_ ? showClock_->wallNow() : now);

@@ -19,6 +19,7 @@
 #include "kiosk/loop/frame_watch.h"
 #include "kiosk/policy/schedule.h"
 #include "kiosk/status/machine_facts.h"
+#include "runtime/bindings.h"
 #include "runtime/bounded_queue.h"
 #include "runtime/clock.h"
 #include "runtime/image.h"
@@ -106,6 +107,26 @@ struct ServerFacts {
   bool readToken = false;  ///< GETs from other machines need the read token
 };
 
+/// \brief What the OSC input (kiosk/osc) counted since the start: messages by outcome, and the
+/// output's messages. None of the refused ones changed the show.
+struct OscFigures {
+  std::string listen;               ///< "udp+tcp 127.0.0.1:9000", "" when not listening
+  std::uint64_t received = 0;       ///< messages taken apart (a bundle's count each)
+  std::uint64_t acted = 0;          ///< handed to the frame loop as a control
+  std::uint64_t unmatched = 0;      ///< `unmatched`: no binding's address
+  std::uint64_t wrongTypes = 0;     ///< `wrong_types`: arguments not of the binding's types, or not finite
+  std::uint64_t badArgument = 0;    ///< `bad_argument`: a string a command cannot take, a command too long
+  std::uint64_t refusedSender = 0;  ///< `refused_sender`: a sender not in osc.allow
+  std::uint64_t rateLimited = 0;    ///< `rate_limited`: over osc.messages_per_second
+  std::uint64_t queueFull = 0;      ///< `queue_full`: the controls' queue was full
+  std::uint64_t malformed = 0;      ///< `malformed`: packets liblo could not take apart
+  std::uint64_t sent = 0;           ///< messages sent to [[osc.send]] destinations
+  std::uint64_t sendFailed = 0;     ///< messages that could not be sent
+  [[nodiscard]] std::uint64_t refused() const {
+    return unmatched + wrongTypes + badArgument + refusedSender + rateLimited + queueFull + malformed;
+  }
+};
+
 /// \brief Everything the server reports, copied at one moment.
 struct StatusSnapshot {
   WallTime now{};
@@ -125,6 +146,7 @@ struct StatusSnapshot {
   std::uint64_t errorsLogged = 0;
   runtime::PerformanceMeter performance;  ///< LAVA's meter, as last sampled (updates == 0: not yet)
   std::optional<FrameLockFigures> lock;   ///< a frame-locked node's figures ([lock]); none otherwise
+  std::optional<OscFigures> osc;          ///< the OSC input's and output's counts ([osc]); none otherwise
   // Filled by the status server when it reports, not by the board:
   std::optional<ProcessFigures> process;  ///< the process's own figures
   std::optional<ServerFacts> server;      ///< the server's set-up (/health)
@@ -132,7 +154,18 @@ struct StatusSnapshot {
 };
 
 /// \brief A request from the control server to the frame loop, answered through `reply`.
-enum class ControlKind : std::uint8_t { kNext, kPrevious, kReload, kRunCommand, kRestartDevice, kCalibrate };
+/// kAction moves the show as a dial would (`action` by `amount`, runtime::applyAction), kResetView
+/// puts its transforms back; both come from OSC (kiosk/osc).
+enum class ControlKind : std::uint8_t {
+  kNext,
+  kPrevious,
+  kReload,
+  kRunCommand,
+  kRestartDevice,
+  kCalibrate,
+  kAction,
+  kResetView
+};
 
 struct ControlReply {
   std::mutex mutex;
@@ -148,9 +181,11 @@ struct ControlReply {
 
 struct ControlRequest {
   ControlKind kind = ControlKind::kNext;
-  std::string argument;  ///< the command, the device's name, or calibration statements
-  std::string view;      ///< kCalibrate: the facet view ("" = the first)
-  bool save = false;     ///< kCalibrate: write the calibration back to the cave file
+  std::string argument;                             ///< the command, the device's name, or calibration statements
+  std::string view;                                 ///< kCalibrate: the facet view ("" = the first)
+  bool save = false;                                ///< kCalibrate: write the calibration back to the cave file
+  runtime::Action action = runtime::Action::kNone;  ///< kAction
+  float amount = 0;                                 ///< kAction: in the action's units (runtime::applyAction)
   std::shared_ptr<ControlReply> reply;
 };
 
@@ -208,7 +243,17 @@ class StatusBoard {
   void publishLock(const FrameLockFigures& figures);
 
   // ---- any thread ----
+  /// \brief The OSC input's counts (its thread publishes them when they change); the sent
+  /// counts are the output's (publishOscSent), kept as they are.
+  void publishOsc(const OscFigures& figures);
+  /// \brief The OSC output's counts (its thread publishes them).
+  void publishOscSent(std::uint64_t sent, std::uint64_t failed);
   [[nodiscard]] StatusSnapshot snapshot(WallTime now) const;
+  /// \brief Copies of parts of snapshot(), for readers that poll often (the OSC output).
+  [[nodiscard]] ShowStatus showStatus() const;
+  [[nodiscard]] std::vector<DeviceStatus> deviceStatus() const;
+  [[nodiscard]] std::optional<FrameLockFigures> lockFigures() const;
+  [[nodiscard]] std::optional<OscFigures> oscFigures() const;
   [[nodiscard]] FrameFigures frameFigures() const;
   BoundedQueue<ControlRequest>& controls() { return controls_; }
   BoundedQueue<std::shared_ptr<SnapshotRequest>>& snapshotRequests() { return snapshots_; }
@@ -257,6 +302,7 @@ class StatusBoard {
   double cpuSum_ = 0;                       // guarded by mutex_
   runtime::PerformanceMeter performance_;   // guarded by mutex_
   std::optional<FrameLockFigures> lock_;    // guarded by mutex_
+  std::optional<OscFigures> osc_;           // guarded by mutex_
   ShowStatus show_;                         // guarded by mutex_
   std::vector<DeviceStatus> devices_;       // guarded by mutex_
   std::vector<StreamStatus> streams_;       // guarded by mutex_

@@ -211,6 +211,21 @@ std::string healthJson(const StatusSnapshot& s) {
         {"movie_frames_corrected", l->movieFramesCorrected},
         {"movie_frames_late", l->movieFramesLate}};
   }
+  if (const std::optional<OscFigures>& o = s.osc) {
+    out["osc"] = {{"listen", o->listen},
+                  {"received", o->received},
+                  {"acted", o->acted},
+                  {"refused",
+                   {{"unmatched", o->unmatched},
+                    {"wrong_types", o->wrongTypes},
+                    {"bad_argument", o->badArgument},
+                    {"refused_sender", o->refusedSender},
+                    {"rate_limited", o->rateLimited},
+                    {"queue_full", o->queueFull},
+                    {"malformed", o->malformed}}},
+                  {"sent", o->sent},
+                  {"send_failed", o->sendFailed}};
+  }
   Json& devices = out["devices"] = Json::array();
   for (const DeviceStatus& d : s.devices) {
     devices.push_back({{"name", d.name},
@@ -463,6 +478,24 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
       lockMetric("basalt_lock_movie_frames_late_total", "counter",
                  "The leader's movie frames not decoded here in time (the frame before stayed).", l->movieFramesLate);
     }
+  }
+  if (const std::optional<OscFigures>& o = s.osc) {
+    metric("basalt_osc_messages_total", "counter",
+           "OSC messages received, by outcome: acted on, or refused (none of those changed the show).");
+    for (const auto& [outcome, count] : {std::pair<std::string_view, std::uint64_t>{"acted", o->acted},
+                                         {"unmatched", o->unmatched},
+                                         {"wrong_types", o->wrongTypes},
+                                         {"bad_argument", o->badArgument},
+                                         {"refused_sender", o->refusedSender},
+                                         {"rate_limited", o->rateLimited},
+                                         {"queue_full", o->queueFull},
+                                         {"malformed", o->malformed}}) {
+      out += fmt::format("basalt_osc_messages_total{{outcome=\"{}\"}} {}\n", outcome, count);
+    }
+    metric("basalt_osc_sent_total", "counter", "OSC messages sent to the show's [[osc.send]] destinations.");
+    out += fmt::format("basalt_osc_sent_total {}\n", o->sent);
+    metric("basalt_osc_send_failures_total", "counter", "OSC messages that could not be sent.");
+    out += fmt::format("basalt_osc_send_failures_total {}\n", o->sendFailed);
   }
   metric("basalt_reloads_total", "counter", "Reloads asked for (SIGHUP or the control server).");
   out += fmt::format("basalt_reloads_total {}\n", s.reloads);

@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include "kiosk/status/guarded_http_server.h"
+#include "kiosk/status/rate_limiter.h"
 #include "media/image_io.h"
 #include "runtime/log.h"
 
@@ -222,36 +223,15 @@ class StatusServer::SnapshotCache {
   std::chrono::steady_clock::time_point takenAt_;
 };
 
-/// Token buckets per client address: `rate` requests a second, bursts of twice that.
+/// Token buckets per client address (RateLimiter, shared with the OSC input), on the system clock.
 class StatusServer::Limiter {
  public:
-  explicit Limiter(double rate) : rate_(rate), burst_(std::max(2.0, rate * 2)) {}
-  bool allow(const std::string& client) {
-    const Nanos now = clock_.now();
-    std::lock_guard lock(mutex_);
-    auto it = buckets_.find(client);
-    if (it == buckets_.end()) {
-      if (buckets_.size() >= 256) buckets_.clear();  // bounded memory, whatever the clients
-      it = buckets_.emplace(client, Bucket{burst_, now}).first;
-    }
-    Bucket& b = it->second;
-    b.tokens = std::min(burst_, b.tokens + toSeconds(now - b.last) * rate_);
-    b.last = now;
-    if (b.tokens < 1) return false;
-    b.tokens -= 1;
-    return true;
-  }
+  explicit Limiter(double rate) : buckets_(rate) {}
+  bool allow(const std::string& client) { return buckets_.allow(client, clock_.now()); }
 
  private:
-  struct Bucket {
-    double tokens;
-    Nanos last;
-  };
-  double rate_;
-  double burst_;
   SystemClock clock_;
-  std::mutex mutex_;
-  std::map<std::string, Bucket> buckets_;  // guarded by mutex_
+  RateLimiter buckets_;
 };
 
 StatusServer::StatusServer(const StatusSpec& spec, StatusBoard& board, std::string token)

@@ -1062,5 +1062,203 @@ TEST(ManifestInput, EvdevModesNamesAndMistakes) {
   EXPECT_NE(off.text.find("reads every key twice"), std::string::npos) << off.text;
 }
 
+// Makes sure [osc] is read into its spec: listen, protocols, the allow-list, the rate (the HTTP
+// controls' by default), each binding's action, types, input, range and mode, and each
+// destination. Example failure: a fader's range read as input, and every move 127 times too far.
+TEST(ManifestOsc, BindingsAndDestinationsAreRead) {
+  ShowFolder f("osc-ok");
+  const auto r = f.read(R"([status]
+requests_per_second = 30
+
+[osc]
+listen = "0.0.0.0:9100"
+protocols = ["udp"]
+allow = ["10.0.0.5", "::1"]
+
+[[osc.bind]]
+address = "/basalt/spin"
+action = "rotate_y"
+input = [0, 127]
+range = [-90, 90]
+mode = "absolute"
+
+[[osc.bind]]
+address = "/basalt/next"
+action = "next"
+types = "f"
+
+[[osc.bind]]
+address = "/basalt/look"
+action = "command"
+command = "render.prim_type = $1"
+types = "s"
+
+[[osc.bind]]
+address = "/basalt/zoom"
+action = "scale"
+
+[[osc.send]]
+to = "192.168.1.20:53000"
+protocol = "tcp"
+prefix = "/node1"
+events = ["item"]
+figures = ["fps", "late_frames"]
+rate = 5
+)");
+  ASSERT_TRUE(r.manifest) << r.text;
+  const OscSpec& o = r.manifest->osc;
+  EXPECT_TRUE(o.enabled);
+  EXPECT_EQ(o.host, "0.0.0.0");
+  EXPECT_EQ(o.port, 9100);
+  EXPECT_TRUE(o.udp);
+  EXPECT_FALSE(o.tcp);
+  EXPECT_EQ(o.allow, (std::vector<std::string>{"10.0.0.5", "::1"}));
+  EXPECT_EQ(o.messagesPerSecond, 30) << "the HTTP controls' rate when [osc] names none";
+  ASSERT_EQ(o.bindings.size(), 4u);
+  EXPECT_EQ(o.bindings[0].what, OscDo::kDial);
+  EXPECT_EQ(o.bindings[0].action, runtime::Action::kRotateY);
+  EXPECT_EQ(o.bindings[0].types, "f");
+  EXPECT_EQ(o.bindings[0].input, (std::array<double, 2>{0, 127}));
+  EXPECT_EQ(o.bindings[0].range, (std::array<double, 2>{-90, 90}));
+  EXPECT_TRUE(o.bindings[0].absolute);
+  EXPECT_EQ(o.bindings[0].line, 9);  // its first key: toml++ places a table of an array there
+  EXPECT_EQ(o.bindings[1].what, OscDo::kNext);
+  EXPECT_EQ(o.bindings[1].types, "f");
+  EXPECT_EQ(o.bindings[2].what, OscDo::kCommand);
+  EXPECT_EQ(o.bindings[2].command, "render.prim_type = $1");
+  // A dial action without a range: one input (0..1) is a turn of LAVA's dial, a doubling for scale.
+  EXPECT_EQ(o.bindings[3].range, (std::array<double, 2>{0, 1}));
+  ASSERT_EQ(o.send.size(), 1u);
+  EXPECT_EQ(o.send[0].host, "192.168.1.20");
+  EXPECT_EQ(o.send[0].port, 53000);
+  EXPECT_TRUE(o.send[0].tcp);
+  EXPECT_EQ(o.send[0].prefix, "/node1");
+  EXPECT_TRUE(o.send[0].item);
+  EXPECT_FALSE(o.send[0].devices);
+  EXPECT_FALSE(o.send[0].lock);
+  EXPECT_EQ(o.send[0].figures, (std::vector<std::string>{"fps", "late_frames"}));
+  EXPECT_EQ(o.send[0].rate, 5);
+  // No allow-list on an open port: said, not refused.
+  const auto open = f.read("[osc]\nlisten = \"0.0.0.0:9000\"\n");
+  ASSERT_TRUE(open.manifest) << open.text;
+  EXPECT_TRUE(hasWarning(open, 2, "lets any machine that reaches port 9000 drive the show")) << open.text;
+  // Without [osc], nothing listens.
+  const auto none = f.read("[show]\nname = \"x\"\n");
+  ASSERT_TRUE(none.manifest) << none.text;
+  EXPECT_FALSE(none.manifest->osc.enabled);
+}
+
+// Makes sure `basalt check` names the line of every OSC mistake: a bad listen address or port,
+// an unknown action (with a suggestion), the wrong number of arguments for an action or a
+// command's placeholders, a bad address, a duplicate, an unknown key, a bad destination.
+// Example failure: `action = "rotate"` accepted and the binding doing nothing on site.
+TEST(ManifestOsc, MistakesAreReportedAtTheirLine) {
+  ShowFolder f("osc-errors");
+  const auto r = f.read(R"([osc]
+listen = "127.0.0.1:70000"
+allow = ["somehost"]
+protocol = ["udp"]
+
+[[osc.bind]]
+address = "/a"
+action = "rotate"
+
+[[osc.bind]]
+address = "/b"
+action = "rotate_x"
+types = "ff"
+
+[[osc.bind]]
+address = "/c"
+action = "command"
+command = "load_object $2"
+types = "s"
+
+[[osc.bind]]
+address = "basalt/d"
+action = "next"
+
+[[osc.bind]]
+address = "/e/*"
+action = "next"
+
+[[osc.bind]]
+address = "/f"
+action = "next"
+types = "s"
+
+[[osc.bind]]
+address = "/g"
+action = "command"
+
+[[osc.bind]]
+address = "/h"
+action = "reload"
+
+[[osc.bind]]
+address = "/h"
+action = "previous"
+
+[[osc.bind]]
+address = "/tracker/1"
+action = "next"
+
+[[osc.bind]]
+address = "/i"
+action = "command"
+command = "render.prim_type = $1"
+types = "sf"
+
+[[osc.send]]
+to = "127.0.0.1"
+
+[[osc.send]]
+to = "127.0.0.1:0"
+figures = ["fps", "frame_rate"]
+events = ["items"]
+)");
+  EXPECT_FALSE(r.manifest) << r.text;
+  EXPECT_TRUE(hasError(r, 2, "osc.listen: port '70000' is not 0 to 65535")) << r.text;
+  EXPECT_TRUE(hasError(r, 3, "osc.allow: 'somehost' is not an IPv4 or IPv6 address")) << r.text;
+  EXPECT_TRUE(hasError(r, 4, "osc.protocol: unknown key; did you mean 'protocols'?")) << r.text;
+  EXPECT_TRUE(hasError(r, 8, "unknown action 'rotate'")) << r.text;
+  EXPECT_TRUE(hasError(r, 13, "wrong arity: 'rotate_x' takes one number")) << r.text;
+  EXPECT_TRUE(hasError(r, 19, "wrong arity: types = \"s\" gives 1 arguments, but the command has no $1")) << r.text;
+  EXPECT_TRUE(hasError(r, 19, "the command uses $2, but types = \"s\" gives 1 argument")) << r.text;
+  EXPECT_TRUE(hasError(r, 22, "osc.bind[3].address: 'basalt/d' must start with '/'")) << r.text;
+  EXPECT_TRUE(hasError(r, 26, "holds '*'")) << r.text;
+  EXPECT_TRUE(hasError(r, 32, "wrong arity: 'next' takes no argument, or one number")) << r.text;
+  EXPECT_TRUE(hasError(r, 34, "action = \"command\" needs command")) << r.text;
+  EXPECT_TRUE(hasError(r, 42, "osc.bind[8].address: '/h' is already bound")) << r.text;
+  EXPECT_TRUE(hasError(r, 47, "kept for tracker devices")) << r.text;
+  EXPECT_TRUE(hasError(r, 54, "types = \"sf\" gives 2 arguments, but the command has no $2")) << r.text;
+  EXPECT_TRUE(hasError(r, 57, "osc.send[0].to: '127.0.0.1' needs a port")) << r.text;
+  EXPECT_TRUE(hasError(r, 60, "port 0 is no destination")) << r.text;
+  EXPECT_TRUE(hasError(r, 61, "'frame_rate' is not one of fps")) << r.text;
+  EXPECT_TRUE(hasError(r, 62, "'items' is not one of item, devices or lock")) << r.text;
+}
+
+// Makes sure `basalt check` itself names the line of an OSC mistake and, for a good show, says
+// what OSC it sets up. Example failure: a wrong arity reported without its line, or a good show's
+// OSC bindings not mentioned, so the technician cannot tell they were read.
+TEST(ManifestOsc, BasaltCheckNamesTheLineAndTheBindings) {
+  ShowFolder f("osc-check");
+  writeFile(f.dir / "show.toml",
+            "[osc]\nlisten = \"127.0.0.1:9000\"\n\n[[osc.bind]]\naddress = \"/spin\"\n"
+            "action = \"rotate_y\"\ntypes = \"fs\"\n");
+  const auto bad = test::run({(test::binaryDir() / "basalt").string(), "check", (f.dir / "show.toml").string()});
+  EXPECT_NE(bad.exitCode, 0) << bad.output;
+  EXPECT_NE(bad.output.find("show.toml:7: error: osc.bind[0]: wrong arity: 'rotate_y' takes one number"),
+            std::string::npos)
+      << bad.output;
+  writeFile(f.dir / "show.toml",
+            "[osc]\nlisten = \"127.0.0.1:9000\"\n\n[[osc.bind]]\naddress = \"/spin\"\n"
+            "action = \"rotate_y\"\n\n[[osc.send]]\nto = \"127.0.0.1:9001\"\n");
+  const auto good = test::run({(test::binaryDir() / "basalt").string(), "check", (f.dir / "show.toml").string()});
+  EXPECT_EQ(good.exitCode, 0) << good.output;
+  EXPECT_NE(good.output.find("; OSC on 127.0.0.1:9000 with 1 binding and 1 destination"), std::string::npos)
+      << good.output;
+}
+
 }  // namespace
 }  // namespace basalt::kiosk
