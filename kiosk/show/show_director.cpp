@@ -96,6 +96,13 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   const WallTime wall = context_.clock.wallNow();
   for (DeviceSlot& slot : show_->devices) slot.since = wall;
   requestDevices();
+  // The facet views' viewer follows the show's tracker; without one it stands where the views
+  // put it (a follower's comes from the leader with every frame).
+  head_.reset();
+  headFrames_ = 0;
+  if (!show_->manifest.viewer.tracker.empty()) head_.emplace(show_->manifest.viewer);
+  if (!follower_) context_.show.head() = {};
+  context_.board.publishTracker(head_ ? &head_->figures() : nullptr);
   for (LoadedTexture& t : show_->textures) {
     if (t.image) {
       if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
@@ -664,6 +671,13 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
   const Nanos now = frame.time;
   serviceDevices(now);
   applyInput(now);
+  if (head_ && !follower_) {
+    head_->update(now, *devices_, context_.show);
+    if (head_->figures().frames != headFrames_) {
+      headFrames_ = head_->figures().frames;
+      context_.board.publishTracker(&head_->figures());
+    }
+  }
   applyOutputInput(now);
   advanceShuttles(now);
   // A frame-locked follower's programme is the leader's (followProgramme): it decides nothing.
