@@ -100,7 +100,7 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   // put it (a follower's comes from the leader with every frame).
   head_.reset();
   headFrames_ = 0;
-  if (!show_->manifest.viewer.tracker.empty()) head_.emplace(show_->manifest.viewer);
+  if (!follower_ && !show_->manifest.viewer.tracker.empty()) head_.emplace(show_->manifest.viewer);
   if (!follower_) context_.show.head() = {};
   context_.board.publishTracker(head_ ? &head_->figures() : nullptr);
   for (LoadedTexture& t : show_->textures) {
@@ -146,6 +146,11 @@ void ShowDirector::requestDevices() {
     const bool camera = slot.spec.kind == DeviceKind::kCamera;
     // A camera opens only when a texture shows it (or the scripts' VCR asks for it).
     if (camera && !cameraShown(slot.spec.name)) continue;
+    // A follower draws the leader's viewer: its own tracker stays closed.
+    if (follower_ && slot.spec.kind == DeviceKind::kTracker) {
+      slot.message = "not read on a frame-locked follower: the leader's viewer is drawn";
+      continue;
+    }
     const std::string name = slot.spec.name;
     auto id = devices_->request(std::move(slot.source.request), std::move(slot.source.provider), slot.source.upkeep);
     // The scripts' VCR may hold the camera already: the show shares it.
@@ -783,6 +788,15 @@ void ShowDirector::setLocked(bool leader, std::chrono::milliseconds patience) {
   locked_ = true;
   follower_ = !leader;
   patience_ = patience;
+  if (follower_ && head_) {
+    // The show was loaded before the lock: the follower's tracker goes, the leader's head comes.
+    log::info(kLogDirector, "tracker '{}' is not read on a frame-locked follower: the leader's viewer is drawn",
+              head_->tracker());
+    devices_->withdraw(head_->tracker());
+    std::erase(requested_, head_->tracker());
+    head_.reset();
+    context_.board.publishTracker(nullptr);
+  }
   if (show_) alignStreams();
   // A leader's movie item that started with the show (before the lock) starts again on the
   // group's timeline, from the item's start: the followers place theirs there.
