@@ -261,7 +261,7 @@ int main(int argc, char** argv) {
     const double cost = moving->second / fixed->second - 1.0;
     std::printf(
         "tracker: a sample changes the frustum %d frame(s) after it (target: the next frame, 1): %s; sample to "
-        "frustum %.2f us of CPU against %.2f us for the frustum alone\n"
+        "frustum %.2f us a frame against %.2f us for the frustum alone\n"
         "tracker: six facets at %ux%u from a moving viewer %.2f ms/frame against %.2f ms from a fixed one: %+.1f %% "
         "(target within 5 %%): %s\n",
         framesToChange, framesToChange == 1 ? "met" : "NOT MET", sample->second * 1e6, only->second * 1e6, kWidth,
