@@ -77,7 +77,7 @@ int devicesMain(std::span<const std::string_view> args) {
   struct Row {
     std::string backend, path, ids, name, text;
   };
-  std::vector<Row> dials, video, problems, others;
+  std::vector<Row> dials, video, trackers, problems, others;
   for (const auto& p : providers) {
     for (const devices::DeviceCandidate& c : p->enumerate()) {
       Row row{c.info.backend, c.info.path, ids(c.info), c.info.name, c.usage};
@@ -89,7 +89,10 @@ int devicesMain(std::span<const std::string_view> args) {
         row.text = c.problem;
         problems.push_back(std::move(row));
       } else {
-        (c.kind == devices::DeviceKind::kDialBox ? dials : video).push_back(std::move(row));
+        (c.kind == devices::DeviceKind::kDialBox   ? dials
+         : c.kind == devices::DeviceKind::kTracker ? trackers
+                                                   : video)
+            .push_back(std::move(row));
       }
     }
   }
@@ -104,6 +107,7 @@ int devicesMain(std::span<const std::string_view> args) {
   };
   print("Dial boxes:", dials);
   print("Video sources:", video);
+  print("Trackers:", trackers);
   print("Found but cannot be opened:", problems);
   print("Other HID devices (not used: no dials):", others);
   if (dials.empty() && video.empty() && problems.empty()) {

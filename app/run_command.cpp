@@ -919,6 +919,8 @@ int runShow(const RunOptions& options) {
     auto made = DisplayViews::create(manifest.views, **renderer, (*output)->size(), calibrations);
     if (!made) return failWith(made.error(), "cannot set up the show's views");
     views = std::move(*made);
+    const auto& at = manifest.viewer.position;
+    views->setViewer({at[0], at[1], at[2]});
     frameLoop.setViewDrawer(views.get());
     director.setViews(views.get());
   }

@@ -19,6 +19,7 @@ std::string_view deviceKindName(DeviceKind kind) {
   switch (kind) {
     case DeviceKind::kDialBox: return "dial box";
     case DeviceKind::kVideoSource: return "video source";
+    case DeviceKind::kTracker: return "tracker";
   }
   return "device";
 }

@@ -23,6 +23,7 @@ std::string_view deviceStateName(DeviceState state);
 enum class DeviceKind : std::uint8_t {
   kDialBox,      ///< dials and buttons: knobs, jog wheels, the SGI box
   kVideoSource,  ///< a camera or a capture card
+  kTracker,      ///< the position and orientation of a head or an object
 };
 
 std::string_view deviceKindName(DeviceKind kind);

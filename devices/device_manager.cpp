@@ -75,6 +75,12 @@ Result<std::shared_ptr<VideoSource>> DeviceProvider::openVideoSource(const Devic
               describeDevice(candidate.info));
 }
 
+Result<std::unique_ptr<Tracker>> DeviceProvider::openTracker(const DeviceCandidate& candidate, const DeviceRequest&,
+                                                             const Clock&) {
+  return fail(Errc::kUnsupported, fmt::format("the {} backend has no trackers", backend()),
+              describeDevice(candidate.info));
+}
+
 // ManagedVideoStream
 
 FrameRef ManagedVideoStream::frameAt(Nanos showTime) {
@@ -180,6 +186,7 @@ Result<DeviceId> DeviceManager::request(DeviceRequest request, std::unique_ptr<D
     slot->stream = std::make_shared<ManagedVideoStream>();
     slot->stream->detach(SourceState::kWaiting, slot->since);
   }
+  if (request.kind == DeviceKind::kTracker) slot->samples = std::make_shared<TrackerSamples>();
   if (provider) provider->watchHotplug([this](HotplugEvent e) { notifyHotplug(std::move(e)); });
   slot->provider = std::move(provider);
   slot->request = std::move(request);
@@ -196,6 +203,7 @@ Result<DeviceId> DeviceManager::request(DeviceRequest request, std::unique_ptr<D
     slot->id = id;
     held_.emplace(name, Held{id, 1, slot->frames});
     if (slot->stream) streams_[name] = slot->stream;
+    if (slot->samples) samples_[name] = slot->samples;
     status_.push_back(statusOf(*slot));
     incoming_.push_back(std::move(slot));
   }
@@ -221,6 +229,7 @@ void DeviceManager::withdraw(std::string_view name) {
     const DeviceId id = it->second.id;
     held_.erase(it);
     if (const auto s = streams_.find(name); s != streams_.end()) streams_.erase(s);
+    if (const auto s = samples_.find(name); s != samples_.end()) samples_.erase(s);
     std::erase_if(status_, [id](const DeviceStatus& st) { return st.id == id; });
     const auto waiting = std::find_if(incoming_.begin(), incoming_.end(), [id](const auto& s) { return s->id == id; });
     if (waiting != incoming_.end()) {
@@ -327,6 +336,19 @@ void DeviceManager::tryOpen(Slot& slot, Nanos now) {
         }
         slot.dial = std::move(*dial);
         slot.device = slot.dial->info();
+      } else if (slot.request.kind == DeviceKind::kTracker) {
+        auto tracker = provider.openTracker(c, slot.request, clock_);
+        if (!tracker) {
+          reasons += "; " + tracker.error().describe();
+          continue;
+        }
+        (*tracker)->setReportTap(reportTap);
+        if (auto r = (*tracker)->open(slot.id, *slot.samples); !r) {
+          reasons += "; " + r.error().describe();
+          continue;
+        }
+        slot.tracker = std::move(*tracker);
+        slot.device = slot.tracker->info();
       } else {
         auto video = provider.openVideoSource(c, slot.request, clock_);
         if (!video) {
@@ -357,7 +379,7 @@ void DeviceManager::tryOpen(Slot& slot, Nanos now) {
       if (tryProvider(*provider)) break;
     }
   }
-  if (slot.dial || slot.video) {
+  if (slot.dial || slot.video || slot.tracker) {
     if (!slot.upkeep.quiet) {
       log::info(kLogDevices, "{} '{}': {} is live{}", deviceKindName(slot.request.kind), slot.request.name,
                 describeDevice(slot.device), wasLost ? " again" : "");
@@ -391,6 +413,10 @@ void DeviceManager::closeDevice(Slot& slot, SourceState streamState, Nanos now) 
   if (slot.dial) {
     slot.dial->close();
     slot.dial.reset();
+  }
+  if (slot.tracker) {
+    slot.tracker->close();
+    slot.tracker.reset();
   }
   if (slot.video) {
     slot.stream->detach(streamState, now);
@@ -495,6 +521,14 @@ void DeviceManager::step(Nanos now) {
           markLost(s, now, why ? why->describe() : "the device stopped answering");
           changed = true;
         }
+      } else if (s.tracker) {
+        if (tapsChanged) s.tracker->setReportTap(reportTap);
+        s.tracker->service(now);
+        if (s.tracker->state() != DeviceState::kLive) {
+          const auto why = s.tracker->lostReason();
+          markLost(s, now, why ? why->describe() : "the tracker stopped answering");
+          changed = true;
+        }
       } else if (s.video) {
         const DeviceState before = s.video->state();
         s.video->service(now);
@@ -529,6 +563,7 @@ DeviceStatus DeviceManager::statusOf(const Slot& s) const {
   st.nextAttempt = s.nextAttempt;
   st.restarts = s.restarts;
   if (s.dial && s.state == DeviceState::kLive) st.reportDescriptor = s.dial->reportDescriptor();
+  if (s.tracker && s.state == DeviceState::kLive) st.reportDescriptor = s.tracker->reportDescriptor();
   if (s.video && s.state == DeviceState::kLive) st.mode = s.video->mode();
   if (s.video && s.state == DeviceState::kLive && s.video->state() != DeviceState::kLive) {
     // The device itself is lost but recovering (an HDMI signal gone): show its state.
@@ -564,6 +599,17 @@ std::shared_ptr<ManagedVideoStream> DeviceManager::videoStream(std::string_view 
   std::lock_guard lock(mutex_);
   const auto it = streams_.find(name);
   return it == streams_.end() ? nullptr : it->second;
+}
+
+std::shared_ptr<TrackerSamples> DeviceManager::trackerSamples(std::string_view name) const {
+  std::lock_guard lock(mutex_);
+  const auto it = samples_.find(name);
+  return it == samples_.end() ? nullptr : it->second;
+}
+
+Tracker* DeviceManager::tracker(std::string_view name) const {
+  const Slot* s = slotNamed(name);
+  return s ? s->tracker.get() : nullptr;
 }
 
 DialBox* DeviceManager::dialBox(std::string_view name) const {

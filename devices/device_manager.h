@@ -27,6 +27,7 @@
 
 #include "devices/device.h"
 #include "devices/dial_box.h"
+#include "devices/tracker.h"
 #include "devices/video_source.h"
 #include "runtime/bounded_queue.h"
 #include "runtime/clock.h"
@@ -114,6 +115,8 @@ class DeviceProvider {
   [[nodiscard]] virtual Result<std::shared_ptr<VideoSource>> openVideoSource(const DeviceCandidate& candidate,
                                                                              const DeviceRequest& request,
                                                                              const Clock& clock);
+  [[nodiscard]] virtual Result<std::unique_ptr<Tracker>> openTracker(const DeviceCandidate& candidate,
+                                                                     const DeviceRequest& request, const Clock& clock);
   /// \brief Backends with hotplug signals of their own (libcamera) report through `notify`
   /// (thread-safe; called by DeviceManager::addProvider).
   virtual void watchHotplug(const std::function<void(HotplugEvent)>& notify) { (void)notify; }
@@ -222,6 +225,11 @@ class DeviceManager {
   [[nodiscard]] std::uint64_t statusVersion() const { return statusVersion_.load(std::memory_order_acquire); }
   /// \brief The stable stream for a video request (null for unknown names or dial boxes).
   [[nodiscard]] std::shared_ptr<ManagedVideoStream> videoStream(std::string_view name) const;
+  /// \brief The samples of a tracker request, stable while its device is unplugged, replaced and
+  /// reopened (null for unknown names and other kinds). Any thread.
+  [[nodiscard]] std::shared_ptr<TrackerSamples> trackerSamples(std::string_view name) const;
+  /// \brief The live tracker of a request, or null (manager thread only).
+  [[nodiscard]] Tracker* tracker(std::string_view name) const;
   /// \brief The live dial box of a request, or null (manager thread only).
   [[nodiscard]] DialBox* dialBox(std::string_view name) const;
   /// \brief The live video source of a request, or null (manager thread only).
@@ -252,6 +260,8 @@ class DeviceManager {
     DeviceInfo device;
     DeviceProvider* foundBy = nullptr;  // the provider of the device in use
     std::unique_ptr<DialBox> dial;
+    std::unique_ptr<Tracker> tracker;
+    std::shared_ptr<TrackerSamples> samples;  // tracker requests: outlives each device
     std::shared_ptr<VideoSource> video;
     std::shared_ptr<ManagedVideoStream> stream;
     std::shared_ptr<FrameFanOut> frames;  // installed on every video source of the request
@@ -290,6 +300,7 @@ class DeviceManager {
   std::vector<HotplugEvent> hotplug_;              // pending notifications (bounded: oldest dropped past 256)
   std::vector<DeviceStatus> status_;               // published after every step that changed something
   std::map<std::string, std::shared_ptr<ManagedVideoStream>, std::less<>> streams_;
+  std::map<std::string, std::shared_ptr<TrackerSamples>, std::less<>> samples_;  // tracker requests
   bool tapsChanged_ = false;
   std::condition_variable wake_;
   bool stopping_ = false;

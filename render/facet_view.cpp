@@ -246,13 +246,15 @@ Result<void> FacetRenderer::draw(Renderer& renderer, const runtime::Show& show, 
     drawEye(head_, viewPass);
     return {};
   }
-  // Thesis §4.4.3: for stereo the viewer position is offset for each eye, along the view's right.
+  // Thesis §4.4.3: for stereo the viewer position is offset for each eye, along the view's right
+  // (or a tracked head's right: the eyes are where the head is turned).
   const std::array<Viewport, 2> eyeViewports = stereoViewports(vp, pass.stereoMode);
   std::array<bool, 2> shown{};
   for (std::size_t eye = 0; eye < 2; ++eye) {
     runtime::FacetViewInput eyeInput = input;
     const float offset = (eye == 0 ? -0.5f : 0.5f) * pass.eyeSpacing;
-    eyeInput.viewer = input.viewer + head_.right * offset;
+    const Vec3 axis = pass.eyeAxis == Vec3{} ? head_.right : pass.eyeAxis;
+    eyeInput.viewer = input.viewer + axis * offset;
     auto r = runtime::computeFacetView(*pass.facet, eyeInput, eyes_[eye]);
     shown[eye] = r && eyes_[eye].visible;
   }

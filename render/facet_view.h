@@ -50,6 +50,9 @@ struct FacetPass {
   bool stereo = false;
   runtime::StereoMode stereoMode = runtime::StereoMode::kAnaglyph;
   float eyeSpacing = 0.0f;  ///< distance between the eyes, in cave units, along the view's right
+  /// The head's right vector (cave axes, unit), along which the eyes sit: a tracked head's. Zero:
+  /// the view's right, as the thesis places the eyes for a viewer who faces each facet.
+  Vec3 eyeAxis;
 };
 
 /// \brief Draws facet views: each a Renderer::draw with the facet's view and projection, then

@@ -7,8 +7,11 @@
 #include "devices/hid/dial_decoder.h"
 #include "devices/midi/midi_decoder.h"
 #include "sim/midi_file.h"
+#include "devices/hid/report_descriptor.h"
+#include "devices/hid/tracker_decoder.h"
 #include "sim/raw_video.h"
 #include "sim/replay.h"
+#include "sim/replay_tracker.h"
 
 namespace basalt::sim {
 
@@ -213,6 +216,19 @@ Result<std::shared_ptr<devices::VideoSource>> SyntheticProvider::openVideoSource
   return fail(Errc::kNotFound, "the synthetic device was unplugged", candidate.info.path);
 }
 
+Result<std::unique_ptr<devices::Tracker>> SyntheticProvider::openTracker(const devices::DeviceCandidate& candidate,
+                                                                         const devices::DeviceRequest& request,
+                                                                         const Clock& clock) {
+  (void)request;
+  std::lock_guard lock(mutex_);
+  for (const auto& e : entries_) {
+    if (e.device.candidate.info.path != candidate.info.path) continue;
+    return std::unique_ptr<devices::Tracker>(
+        std::make_unique<SyntheticTracker>(e.device.candidate.info, e.device.tracker, clock, e.present));
+  }
+  return fail(Errc::kNotFound, "the synthetic device was unplugged", candidate.info.path);
+}
+
 // ReplayProvider
 
 ReplayProvider::ReplayProvider(TraceVideoReaderFactory videoReader)
@@ -255,7 +271,14 @@ Result<void> ReplayProvider::addHidRecording(const std::filesystem::path& file) 
     e.candidate.info.product = d.product;
     e.candidate.info.path = multi ? fmt::format("{}#{}", file.string(), d.index) : file.string();
     auto decoder = devices::DialDecoder::create(d.vendor, d.product, d.descriptor, e.candidate.info.path);
-    if (decoder) {
+    auto parsed = devices::hid::parseReportDescriptor(d.descriptor, e.candidate.info.path);
+    auto tracker = parsed ? devices::TrackerDecoder::create(*parsed, e.candidate.info.path)
+                          : Result<devices::TrackerDecoder>(std::unexpected(parsed.error()));
+    if (tracker) {
+      e.candidate.kind = devices::DeviceKind::kTracker;
+      e.candidate.usage =
+          fmt::format("tracker: X/Y/Z{}, {} reports", tracker->hasRotation() ? ", Rx/Ry/Rz" : "", d.reports.size());
+    } else if (decoder) {
       e.candidate.usage = fmt::format("{}: {} dial(s), {} button(s), {} reports", dialProfileName(decoder->profile()),
                                       decoder->dialCount(), decoder->buttonCount(), d.reports.size());
     } else {
@@ -283,7 +306,7 @@ Result<void> ReplayProvider::addTrace(const std::filesystem::path& folder) {
       if (!rec) return std::unexpected(rec.error());
       e.hid = std::move(*rec);
       e.candidate.usage = fmt::format("recorded {} with {} MIDI messages", d.info.name, e.hid.reports.size());
-    } else if (d.kind == devices::DeviceKind::kDialBox) {
+    } else if (d.kind != devices::DeviceKind::kVideoSource) {
       auto rec = readHidRecording(folder / d.file);
       if (!rec) return std::unexpected(rec.error());
       if (rec->devices.empty()) return fail(Errc::kParse, "the recording has no device", (folder / d.file).string());
@@ -328,6 +351,20 @@ Result<std::unique_ptr<devices::DialBox>> ReplayProvider::openDialBox(const devi
     auto dial = ReplayDialBox::create(e.candidate.info, e.hid, clock, *loop);
     if (!dial) return std::unexpected(dial.error());
     return std::unique_ptr<devices::DialBox>(std::move(*dial));
+  }
+  return fail(Errc::kNotFound, "no such recorded device", candidate.info.path);
+}
+
+Result<std::unique_ptr<devices::Tracker>> ReplayProvider::openTracker(const devices::DeviceCandidate& candidate,
+                                                                      const devices::DeviceRequest& request,
+                                                                      const Clock& clock) {
+  auto loop = boolOption(request, "loop", true);
+  if (!loop) return std::unexpected(loop.error());
+  for (const Entry& e : entries_) {
+    if (e.candidate.info.path != candidate.info.path) continue;
+    auto tracker = ReplayTracker::create(e.candidate.info, e.hid, clock, *loop);
+    if (!tracker) return std::unexpected(tracker.error());
+    return std::unique_ptr<devices::Tracker>(std::move(*tracker));
   }
   return fail(Errc::kNotFound, "no such recorded device", candidate.info.path);
 }

@@ -15,6 +15,7 @@
 #include "sim/hid_recording.h"
 #include "sim/synthetic_camera.h"
 #include "sim/synthetic_dial.h"
+#include "sim/synthetic_tracker.h"
 #include "sim/trace.h"
 #include "sim/trace_video.h"
 
@@ -37,6 +38,7 @@ class SyntheticProvider final : public devices::DeviceProvider {
     std::vector<ScriptedInput> script;  ///< dial boxes
     bool loop = true;
     SyntheticCameraConfig camera;  ///< cameras
+    TrackerPath tracker;           ///< trackers
   };
 
   /// \brief With the default dial box and camera.
@@ -60,6 +62,9 @@ class SyntheticProvider final : public devices::DeviceProvider {
   Result<std::shared_ptr<devices::VideoSource>> openVideoSource(const devices::DeviceCandidate& candidate,
                                                                 const devices::DeviceRequest& request,
                                                                 const Clock& clock) override;
+  Result<std::unique_ptr<devices::Tracker>> openTracker(const devices::DeviceCandidate& candidate,
+                                                        const devices::DeviceRequest& request,
+                                                        const Clock& clock) override;
 
  private:
   struct Entry {
@@ -79,7 +84,8 @@ class SyntheticProvider final : public devices::DeviceProvider {
 /// Each device's path is `FILE` (single-device files) or `FILE#N` (device D:N of a multi-device
 /// file); its name, vendor and product are the recorded ones.
 ///
-/// Request options it reads: `loop` (true/false, default true).
+/// Request options it reads: `loop` (true/false, default true). A recording whose descriptor
+/// has absolute X, Y and Z (a tracker's, or Basalt's virtual tracker) is offered as a tracker.
 class ReplayProvider final : public devices::DeviceProvider {
  public:
   /// \brief `videoReader` opens trace videos (default: .bvraw only; the kiosk injects media's
@@ -104,12 +110,15 @@ class ReplayProvider final : public devices::DeviceProvider {
   Result<std::shared_ptr<devices::VideoSource>> openVideoSource(const devices::DeviceCandidate& candidate,
                                                                 const devices::DeviceRequest& request,
                                                                 const Clock& clock) override;
+  Result<std::unique_ptr<devices::Tracker>> openTracker(const devices::DeviceCandidate& candidate,
+                                                        const devices::DeviceRequest& request,
+                                                        const Clock& clock) override;
 
  private:
   struct Entry {
     std::string requestName;
     devices::DeviceCandidate candidate;
-    HidRecordedDevice hid;        // dial boxes
+    HidRecordedDevice hid;        // dial boxes and trackers
     std::filesystem::path video;  // video sources
   };
   TraceVideoReaderFactory videoReader_;

@@ -170,7 +170,9 @@ std::string formatTraceToml(const TraceInfo& info) {
   for (const TraceDevice& d : info.devices) {
     out += "\n[[device]]\n";
     out += fmt::format("name = {}\n", quote(d.name));
-    out += fmt::format("kind = {}\n", quote(d.kind == devices::DeviceKind::kDialBox ? "dial box" : "video source"));
+    out += fmt::format("kind = {}\n", quote(d.kind == devices::DeviceKind::kDialBox   ? "dial box"
+                                            : d.kind == devices::DeviceKind::kTracker ? "tracker"
+                                                                                      : "video source"));
     out += fmt::format("file = {}\n", quote(d.file));
     out += fmt::format("device = {}\n", quote(d.info.name));
     out += fmt::format("backend = {}\n", quote(d.info.backend));
@@ -179,7 +181,7 @@ std::string formatTraceToml(const TraceInfo& info) {
     out += fmt::format("product = \"{:04x}\"\n", d.info.product);
     out += fmt::format("path = {}\n", quote(d.info.path));
     if (!d.info.serial.empty()) out += fmt::format("serial = {}\n", quote(d.info.serial));
-    if (d.kind == devices::DeviceKind::kDialBox) {
+    if (d.kind != devices::DeviceKind::kVideoSource) {
       out += fmt::format("descriptor = \"{}\"\n", hexBytes(d.descriptor));
     } else {
       out += fmt::format("format = {}\n", quote(pixelFormatName(d.mode.format)));
@@ -289,8 +291,10 @@ Result<TraceInfo> parseTraceToml(std::string_view text, std::string_view name) {
           d.kind = devices::DeviceKind::kDialBox;
         } else if (*s == "video source") {
           d.kind = devices::DeviceKind::kVideoSource;
+        } else if (*s == "tracker") {
+          d.kind = devices::DeviceKind::kTracker;
         } else {
-          return bad(fmt::format("kind '{}' is not \"dial box\" or \"video source\"", *s));
+          return bad(fmt::format("kind '{}' is not \"dial box\", \"tracker\" or \"video source\"", *s));
         }
       }
       if (key == "format") {
@@ -490,11 +494,21 @@ void TraceRecorder::noteError(const Error& e) {
 
 Result<void> TraceRecorder::addDialBox(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
                                        const std::vector<std::uint8_t>& descriptor) {
+  return addHidDevice(id, name, info, descriptor, devices::DeviceKind::kDialBox);
+}
+
+Result<void> TraceRecorder::addTracker(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
+                                       const std::vector<std::uint8_t>& descriptor) {
+  return addHidDevice(id, name, info, descriptor, devices::DeviceKind::kTracker);
+}
+
+Result<void> TraceRecorder::addHidDevice(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
+                                         const std::vector<std::uint8_t>& descriptor, devices::DeviceKind kind) {
   std::lock_guard lock(mutex_);
   if (dials_.contains(id)) return {};
   TraceDevice d;
   d.name = name;
-  d.kind = devices::DeviceKind::kDialBox;
+  d.kind = kind;
   d.info = info;
   d.file = name + ".hid";
   d.descriptor = descriptor;

@@ -37,7 +37,7 @@ struct TraceDevice {
   devices::DeviceKind kind = devices::DeviceKind::kDialBox;
   devices::DeviceInfo info;              ///< identity at recording time
   std::string file;                      ///< relative to the trace folder
-  std::vector<std::uint8_t> descriptor;  ///< dial boxes: the report descriptor
+  std::vector<std::uint8_t> descriptor;  ///< dial boxes and trackers: the report descriptor
   devices::VideoMode mode;               ///< video sources
 };
 
@@ -86,6 +86,10 @@ class TraceRecorder final : public devices::ReportTap, public devices::FrameTap 
   /// \brief Records device `id` (the DeviceManager's id) as `name`.
   [[nodiscard]] Result<void> addDialBox(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
                                         const std::vector<std::uint8_t>& descriptor);
+  /// \brief Records tracker `id` as `name`: its reports (a HID tracker's own, or the virtual
+  /// tracker's) into a hid-recorder file, as a dial box's.
+  [[nodiscard]] Result<void> addTracker(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
+                                        const std::vector<std::uint8_t>& descriptor);
   [[nodiscard]] Result<void> addVideoSource(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
                                             const devices::VideoMode& mode);
 
@@ -115,6 +119,8 @@ class TraceRecorder final : public devices::ReportTap, public devices::FrameTap 
  private:
   TraceRecorder(std::filesystem::path folder, const Clock& clock, Options options, UniqueFd mark, bool madeFolder,
                 std::vector<std::string> replaced);
+  [[nodiscard]] Result<void> addHidDevice(DeviceId id, const std::string& name, const devices::DeviceInfo& info,
+                                          const std::vector<std::uint8_t>& descriptor, devices::DeviceKind kind);
   void stopWriting();
   void writerLoop();
   void noteError(const Error& e);

@@ -29,6 +29,9 @@ class HidProvider final : public DeviceProvider {
   std::vector<DeviceCandidate> enumerate() override;
   Result<std::unique_ptr<DialBox>> openDialBox(const DeviceCandidate& candidate, const DeviceRequest& request,
                                                const Clock& clock) override;
+  /// \brief A hidraw node with absolute X, Y and Z (devices/hid/tracker_decoder.h).
+  Result<std::unique_ptr<Tracker>> openTracker(const DeviceCandidate& candidate, const DeviceRequest& request,
+                                               const Clock& clock) override;
 };
 
 /// \brief Reads a hidraw node's report descriptor from sysfs (/sys/class/hidraw/NAME/device/
@@ -41,6 +44,9 @@ class HidProvider final : public DeviceProvider {
 
 /// \brief Opens a hidraw node as a dial box directly (tests, `basalt record --hid PATH`).
 [[nodiscard]] Result<std::unique_ptr<DialBox>> openHidrawDialBox(const std::string& devnode, const Clock& clock);
+
+/// \brief Opens a hidraw node as a tracker directly (tests).
+[[nodiscard]] Result<std::unique_ptr<Tracker>> openHidrawTracker(const std::string& devnode, const Clock& clock);
 
 /// \brief Opens the first PowerMate on USB whose `usb:BUS-PORTS` path is `path` (any when empty).
 [[nodiscard]] Result<std::unique_ptr<DialBox>> openPowerMate(const std::string& path, const Clock& clock);

@@ -6,6 +6,12 @@
 // descriptor is read from sysfs, since hidapi 0.13 cannot return it. Limits: input reports only
 // (no feature reports: a Surface Dial's resolution multiplier stays at the device's default), up
 // to 32 dials and 64 buttons; reads poll every 100 ms for close().
+//
+// Trackers on hidraw: any HID device with absolute Generic Desktop X, Y and Z (and optionally
+// Rx, Ry, Rz) in one input report (devices/hid/tracker_decoder.h), such as a head tracker that
+// presents itself as a generic 6-axis HID device. Such a device is offered both as a tracker and,
+// where its axes make dials, as a dial box; the manifest's kind picks. Each report is stamped on
+// the show's Clock when read.
 
 #include <hidapi/hidapi.h>
 #include <unistd.h>
@@ -22,6 +28,7 @@
 #include "devices/hid/decoding_dial_box.h"
 #include "devices/hid/dial_decoder.h"
 #include "devices/hid/hid_backend.h"
+#include "devices/hid/tracker_decoder.h"
 
 namespace basalt::devices {
 
@@ -105,6 +112,68 @@ class HidrawDialBox final : public DecodingDialBox {
   HidDevicePtr device_;
 };
 
+/// A tracker on a hidraw node: a reader thread decodes each report into a sample.
+class HidrawTracker final : public Tracker {
+ public:
+  HidrawTracker(DeviceInfo info, std::vector<std::uint8_t> descriptor, TrackerDecoder decoder, const Clock& clock)
+      : Tracker(std::move(info), true), decoder_(std::move(decoder)), clock_(clock) {
+    setReportDescriptor(std::move(descriptor));
+  }
+  ~HidrawTracker() override { close(); }
+
+ private:
+  Result<void> doOpen() override {
+    if (!hidInit()) return fail(Errc::kUnavailable, "hidapi could not start", info().path);
+    HidDevicePtr dev(hid_open_path(info().path.c_str()));
+    if (!dev) {
+      const int e = errno;
+      if (e == EACCES || e == EPERM) {
+        return fail(Errc::kPermissionDenied, fmt::format("permission denied; {}", kUdevRuleHint), info().path);
+      }
+      return fail(Errc::kUnavailable, fmt::format("cannot open: {}", hidError(nullptr)), info().path);
+    }
+    device_ = std::move(dev);
+    stop_.store(false);
+    reader_ = std::thread([this] { readLoop(); });
+    return {};
+  }
+
+  void doClose() override {
+    stop_.store(true);
+    if (reader_.joinable()) reader_.join();
+    device_.reset();
+  }
+
+  void readLoop() {
+    std::array<std::uint8_t, 4096> buf{};
+    while (!stop_.load()) {
+      const int n = hid_read_timeout(device_.get(), buf.data(), buf.size(), 100);
+      if (n < 0) {
+        reportLost(Error(Errc::kDeviceLost, fmt::format("read failed: {}", hidError(device_.get())), info().path));
+        return;
+      }
+      if (n == 0) continue;
+      const std::span<const std::uint8_t> report(buf.data(), static_cast<std::size_t>(n));
+      const Nanos now = clock_.now();
+      tapReport(now, report);
+      if (auto sample = decoder_.decode(report, now)) emit(*sample);
+    }
+  }
+
+  TrackerDecoder decoder_;  // read by the reader thread only (immutable after construction)
+  const Clock& clock_;
+  std::atomic<bool> stop_{false};  // set by doClose(), read by the reader thread
+  std::thread reader_;
+  HidDevicePtr device_;  // opened before the reader starts, closed after it is joined
+};
+
+/// The tracker decoder for a descriptor, or why it is not a tracker.
+Result<TrackerDecoder> trackerDecoder(const std::vector<std::uint8_t>& descriptor, const std::string& where) {
+  auto parsed = hid::parseReportDescriptor(descriptor, where);
+  if (!parsed) return std::unexpected(parsed.error());
+  return TrackerDecoder::create(*parsed, where);
+}
+
 }  // namespace
 
 Result<std::vector<std::uint8_t>> readHidrawDescriptor(const std::string& devnode) {
@@ -146,6 +215,27 @@ std::string hidrawAccessProblem(const std::string& devnode) {
   return systemErrorText("cannot open", e);
 }
 
+Result<std::unique_ptr<Tracker>> openHidrawTracker(const std::string& devnode, const Clock& clock) {
+  if (!hidInit()) return fail(Errc::kUnavailable, "hidapi could not start", devnode);
+  DeviceInfo info{"", "hid", "unknown", 0, 0, devnode, ""};
+  HidEnumerationPtr list(hid_enumerate(0, 0));
+  for (hid_device_info* d = list.get(); d; d = d->next) {
+    if (devnode != d->path) continue;
+    info.name = narrow(d->product_string);
+    info.vendor = d->vendor_id;
+    info.product = d->product_id;
+    info.serial = narrow(d->serial_number);
+    info.bus = busOf(d->bus_type);
+  }
+  auto descriptor = readHidrawDescriptor(devnode);
+  if (!descriptor) return std::unexpected(descriptor.error());
+  auto decoder = trackerDecoder(*descriptor, devnode);
+  if (!decoder) return std::unexpected(decoder.error());
+  if (info.name.empty()) info.name = "HID tracker";
+  return std::unique_ptr<Tracker>(
+      std::make_unique<HidrawTracker>(std::move(info), std::move(*descriptor), std::move(*decoder), clock));
+}
+
 HidProvider::HidProvider() = default;
 HidProvider::~HidProvider() = default;
 
@@ -172,11 +262,25 @@ std::vector<DeviceCandidate> HidProvider::enumerate() {
                               decoder->buttonCount());
         c.problem = hidrawAccessProblem(c.info.path);
       }
+      if (descriptor) {
+        if (auto tracker = trackerDecoder(*descriptor, c.info.path)) {
+          DeviceCandidate t = c;
+          t.kind = DeviceKind::kTracker;
+          t.usage = fmt::format("tracker: X/Y/Z{}", tracker->hasRotation() ? ", Rx/Ry/Rz" : "");
+          t.problem = hidrawAccessProblem(c.info.path);
+          out.push_back(std::move(t));
+        }
+      }
       out.push_back(std::move(c));
     }
   }
   for (DeviceCandidate& c : listPowerMates()) out.push_back(std::move(c));
   return out;
+}
+
+Result<std::unique_ptr<Tracker>> HidProvider::openTracker(const DeviceCandidate& candidate, const DeviceRequest&,
+                                                          const Clock& clock) {
+  return openHidrawTracker(candidate.info.path, clock);
 }
 
 Result<std::unique_ptr<DialBox>> HidProvider::openDialBox(const DeviceCandidate& candidate, const DeviceRequest&,

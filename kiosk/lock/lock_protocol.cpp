@@ -16,7 +16,7 @@ static_assert(std::endian::native == std::endian::little, "the frame-lock encodi
 namespace {
 
 constexpr std::array<char, 4> kMagic{'B', 'L', 'C', 'K'};
-constexpr std::uint8_t kVersion = 3;
+constexpr std::uint8_t kVersion = 4;
 
 class Writer {
  public:
@@ -169,6 +169,7 @@ LockedShowState captureLockedState(const runtime::Show& show) {
   s.viewerPosition = show.viewer().position;
   s.viewerRotation = show.viewer().rotation;
   s.eyeSpacing = show.viewer().eyeSpacing;
+  s.head = show.head();
   return s;
 }
 
@@ -192,6 +193,7 @@ void applyLockedState(const LockedShowState& s, runtime::Show& show) {
   show.viewer().position = s.viewerPosition;
   show.viewer().rotation = s.viewerRotation;
   show.viewer().eyeSpacing = s.eyeSpacing;
+  show.head() = s.head;
 }
 
 std::string ReadyMessage::nodeName() const {
@@ -261,6 +263,11 @@ std::size_t encode(const FrameMessage& m, LockBuffer& out) {
   w.put(m.movies.item);
   for (const std::int32_t shown : m.movies.textures) w.put(shown);
   w.put(m.session);
+  const runtime::HeadPose& h = s.head;
+  w.put(static_cast<std::uint32_t>(h.tracked ? 1U : 0U));
+  w.put(h.position);
+  w.put(h.right);
+  w.put(static_cast<std::int64_t>(h.sampleTime.count()));
   return w.size();
 }
 
@@ -411,6 +418,13 @@ Result<FrameMessage> decodeFrame(std::span<const std::byte> bytes) {
   movies.item = r.get<std::int32_t>();
   for (std::int32_t& shown : movies.textures) shown = r.get<std::int32_t>();
   m.session = r.get<std::uint32_t>();
+  runtime::HeadPose& head = s.head;
+  const auto headFlags = r.get<std::uint32_t>();
+  head.position = r.vec3();
+  head.right = r.vec3();
+  head.sampleTime = Nanos{r.get<std::int64_t>()};
+  if (headFlags > 1) return fail(Errc::kParse, "frame-lock message: the 'frame' message's head flags are unknown");
+  head.tracked = headFlags == 1;
   if (movies.item < -1 ||
       std::any_of(movies.textures.begin(), movies.textures.end(), [](std::int32_t shown) { return shown < -1; })) {
     return fail(Errc::kParse, "frame-lock message: a movie frame below -1 (-1 means none)");

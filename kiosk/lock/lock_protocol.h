@@ -5,14 +5,15 @@
 /// sends each frame, and what the followers answer. Plain encoding and decoding, no sockets:
 /// `kiosk/lock/frame_lock.cpp` carries the bytes over ZeroMQ, and every message is one ZeroMQ frame.
 ///
-/// Layout: every message starts with the 4 bytes "BLCK", a version byte (3), a kind byte and
+/// Layout: every message starts with the 4 bytes "BLCK", a version byte (4), a kind byte and
 /// two bytes of zero, then the kind's fixed fields, little-endian (integers two's complement,
 /// floats IEEE 754). The size of each kind is fixed; a message of another size, another magic or
 /// version, an unknown kind or a non-finite number is rejected with the reason. Version 2 added
 /// the director's programme (LockedProgramme) to the `frame` message; version 3 the leader's
 /// script commands (LockedCommand in `frame`, and the `resend` and `command` kinds that bring a
 /// follower the commands it missed) and the movie frame each of its movies shows
-/// (LockedMovieFrames in `frame`).
+/// (LockedMovieFrames in `frame`); version 4 the tracked viewer of the facet views (the
+/// state's `head`, at the end of `frame`), so that every node draws its facets from one head.
 
 #include <algorithm>
 #include <array>
@@ -23,6 +24,7 @@
 #include <string>
 
 #include "runtime/error.h"
+#include "runtime/head_tracking.h"
 #include "runtime/math.h"
 #include "runtime/show/attributes.h"
 
@@ -53,6 +55,9 @@ struct LockedShowState {
   Vec3 viewerPosition;
   Vec3 viewerRotation;
   float eyeSpacing = 0.04f;
+  /// The tracked head of the facet views (Show::head()): the leader's, smoothed, so that every
+  /// node's frusta follow the same viewer on the same frame. Encoded after the movie frames.
+  runtime::HeadPose head;
   friend bool operator==(const LockedShowState&, const LockedShowState&) = default;
 };
 
@@ -201,8 +206,10 @@ constexpr std::size_t kLockedProgrammeBytes = 64 + 8 * kLockedMovieStreams;
 constexpr std::size_t kLockedCommandBytes = 16 + kFrameCommandBytes;
 /// The item's and the movie streams' frames, the leader's session.
 constexpr std::size_t kLockedMovieFramesBytes = 8 + 4 * kLockedMovieStreams;
-constexpr std::size_t kFrameMessageBytes =
-    kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes + kLockedCommandBytes + kLockedMovieFramesBytes;
+/// The tracked head: flags, position, right vector, the newest sample's time (since version 4).
+constexpr std::size_t kLockedHeadBytes = 4 + 12 + 12 + 8;
+constexpr std::size_t kFrameMessageBytes = kLockHeaderBytes + 24 + kLockedStateBytes + kLockedProgrammeBytes +
+                                           kLockedCommandBytes + kLockedMovieFramesBytes + kLockedHeadBytes;
 constexpr std::size_t kPresentMessageBytes = kLockHeaderBytes + 8;
 constexpr std::size_t kReadyMessageBytes = kLockHeaderBytes + 24 + 32;
 constexpr std::size_t kByeMessageBytes = kLockHeaderBytes + 8;

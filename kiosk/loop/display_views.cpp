@@ -126,8 +126,9 @@ std::optional<std::size_t> DisplayViews::facetViewNamed(const std::string& of) c
   return std::nullopt;
 }
 
-runtime::FacetViewInput DisplayViews::facetInput(const View& v, const runtime::Show& show) {
+runtime::FacetViewInput DisplayViews::facetInput(const View& v, const runtime::Show& show) const {
   runtime::FacetViewInput input;
+  input.viewer = show.head().tracked ? show.head().position : viewer_;
   input.calibration = v.cave.settings;
   input.worldFromCave = runtime::cavePlacement(show);
   input.farDistance = show.viewer().farClip;
@@ -204,10 +205,11 @@ void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
           case S::kTopBottom: pass.stereo = true, pass.stereoMode = runtime::StereoMode::kTopBottom; break;
         }
         pass.eyeSpacing = v.eyeSpacing >= 0 ? v.eyeSpacing : show.stereo().eyeSpacing;
+        if (show.head().tracked) pass.eyeAxis = show.head().right;
         const auto r = facets_->draw(renderer_, show, pass, adjust);
         v.last = facets_->lastProjection();
         const bool empty = !r || !v.last.visible;
-        if (empty != v.empty) noteEmpty(v, index, empty, r ? nullptr : &r.error());
+        if (empty != v.empty) noteEmpty(v, index, empty, r ? nullptr : &r.error(), pass.input.viewer);
         break;
       }
       case ViewKind::kAids: drawAids(v, show, adjust); break;
@@ -215,7 +217,7 @@ void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
   }
 }
 
-void DisplayViews::noteEmpty(View& v, std::uint32_t index, bool empty, const Error* error) {
+void DisplayViews::noteEmpty(View& v, std::uint32_t index, bool empty, const Error* error, const Vec3& at) {
   v.empty = empty;
   if (!empty) {
     v.emptyWhy.clear();
@@ -236,9 +238,10 @@ void DisplayViews::noteEmpty(View& v, std::uint32_t index, bool empty, const Err
           facet);
     } else {
       v.emptyWhy = fmt::format(
-          "the viewer, at the display geometry's origin, is behind or on the plane of {}: the "
-          "origin is outside the display; model the display around its origin",
-          facet);
+          "the viewer, at ({}, {}, {}) in the display geometry's units, is behind or on the plane "
+          "of {}: it is outside the display; model the display around its origin, or move the "
+          "viewer inside ([viewer] position, or the tracker)",
+          at.x, at.y, at.z, facet);
     }
     log::warn(kLogViews, "view '{}' draws nothing (reported once): {}", v.spec.name, v.emptyWhy);
   }

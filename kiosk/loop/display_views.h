@@ -57,6 +57,12 @@ class DisplayViews final : public ViewDrawer {
   void drawViews(const runtime::Show& show, render::Size output,
                  const std::function<void(runtime::ViewTransforms&)>& adjust) override;
 
+  /// \brief Where the facet views' viewer is while no tracker moves it (`[viewer] position`),
+  /// in the display geometry's units; the origin until set. A tracked head (`Show::head()`)
+  /// takes its place while it is tracked, and places the stereo eyes along its right vector.
+  void setViewer(const Vec3& position) { viewer_ = position; }
+  [[nodiscard]] const Vec3& viewer() const { return viewer_; }
+
   /// \brief A keyboard event for the calibration keys; they act on the current facet view
   /// (the first, or the one chosen with selectView). True when something changed.
   bool applyKey(const Event& event);
@@ -104,11 +110,12 @@ class DisplayViews final : public ViewDrawer {
   /// The facet view `of` names (the first facet view when empty), if any.
   [[nodiscard]] std::optional<std::size_t> facetViewNamed(const std::string& of) const;
   /// The facet input of facet view `v` this frame (no aspect: the caller sets it).
-  static runtime::FacetViewInput facetInput(const View& v, const runtime::Show& show);
+  [[nodiscard]] runtime::FacetViewInput facetInput(const View& v, const runtime::Show& show) const;
   void drawAids(View& v, const runtime::Show& show, const std::function<void(runtime::ViewTransforms&)>& adjust);
   /// Notes that facet view `v` (showing facet `index`) drew nothing or something again: logged,
-  /// and problems() rebuilt, only when that changes. `error` is the draw's error, if any.
-  void noteEmpty(View& v, std::uint32_t index, bool empty, const Error* error);
+  /// and problems() rebuilt, only when that changes. `error` is the draw's error, if any; `at`
+  /// the viewer it was drawn from (display units).
+  void noteEmpty(View& v, std::uint32_t index, bool empty, const Error* error, const Vec3& at);
   /// Starts facet view `v` from its saved calibration when there is one newer than its cave file.
   void readSavedCalibration(View& v) const;
   DisplayViews(render::Renderer& renderer, std::unique_ptr<render::FacetRenderer> facets,
@@ -119,6 +126,7 @@ class DisplayViews final : public ViewDrawer {
   std::unique_ptr<render::FacetRenderer> facets_;
   std::filesystem::path savedCalibrations_;  ///< empty: calibrations are saved to the cave files
   std::vector<View> views_;
+  Vec3 viewer_;  ///< the fixed viewer (display units)
   std::size_t current_ = 0;
   runtime::CaveKeys keys_;
   std::vector<std::string> problems_;

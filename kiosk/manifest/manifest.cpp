@@ -99,7 +99,14 @@ std::string_view mediaKindName(MediaKind kind) {
   return "?";
 }
 
-std::string_view deviceKindName(DeviceKind kind) { return kind == DeviceKind::kDialBox ? "dial_box" : "camera"; }
+std::string_view deviceKindName(DeviceKind kind) {
+  switch (kind) {
+    case DeviceKind::kDialBox: return "dial_box";
+    case DeviceKind::kCamera: return "camera";
+    case DeviceKind::kTracker: return "tracker";
+  }
+  return "device";
+}
 
 std::string_view deviceBackendName(DeviceBackend backend) {
   switch (backend) {
@@ -708,12 +715,13 @@ class Reader {
     manifest_.entry = {EntryKind::kBuiltinDefault, "default", {}, 0};
 
     checkKeys(root, "",
-              {"show", "output", "views", "media", "devices", "bindings", "textures", "kiosk", "status", "input",
-               "lock", "osc"});
+              {"show", "output", "views", "viewer", "media", "devices", "bindings", "textures", "kiosk", "status",
+               "input", "lock", "osc"});
     if (const toml::table* t = table(root, "show", "")) readShow(*t);
     if (const toml::table* t = table(root, "output", "")) readOutput(*t);
     readViews(root);
     if (const toml::table* t = table(root, "devices", "")) readDevices(*t);
+    if (const toml::table* t = table(root, "viewer", "")) readViewer(*t);
     if (const toml::table* t = table(root, "media", "")) readMedia(*t);
     readBindings(root);
     if (const toml::table* t = table(root, "textures", "")) readTextures(*t);
@@ -1160,6 +1168,86 @@ class Reader {
     }
   }
 
+  // ---- [viewer] ----
+  void readViewer(const toml::table& t) {
+    ViewerSpec& v = manifest_.viewer;
+    v.line = lineOf(t);
+    checkKeys(t, "viewer",
+              {"position", "tracker", "smoothing", "time_constant_ms", "min_cutoff", "beta", "tracker_offset",
+               "tracker_scale"});
+    if (const toml::node* position = t.get("position")) {
+      if (auto p = point(*position)) {
+        v.position = *p;
+      } else {
+        error(lineOf(*position), "viewer.position: must be a point [x, y, z] in the display geometry's units");
+      }
+    }
+    if (auto tracker = string(t, "tracker", "viewer")) {
+      const DeviceSpec* d = manifest_.findDevice(*tracker);
+      if (!d) {
+        error(lineOf(*t.get("tracker")),
+              fmt::format("viewer.tracker: no device '{}' in [devices]; add one with kind = \"tracker\"", *tracker));
+      } else if (d->kind != DeviceKind::kTracker) {
+        error(lineOf(*t.get("tracker")),
+              fmt::format("viewer.tracker: '{}' is a {}, not a tracker", *tracker, deviceKindName(d->kind)));
+      } else {
+        v.tracker = *tracker;
+      }
+    }
+    using Kind = runtime::HeadSmoothing::Kind;
+    if (auto kind =
+            choice<Kind>(t, "smoothing", "viewer",
+                         {{"one_euro", Kind::kOneEuro}, {"exponential", Kind::kExponential}, {"off", Kind::kOff}})) {
+      v.smoothing.kind = *kind;
+    }
+    if (auto ms = number(t, "time_constant_ms", "viewer", 0, 10000)) {
+      v.smoothing.timeConstant = Nanos{static_cast<std::int64_t>(*ms * 1e6)};
+    }
+    if (auto cutoff = number(t, "min_cutoff", "viewer", 0.001, 1000)) v.smoothing.minCutoff = *cutoff;
+    if (auto beta = number(t, "beta", "viewer", 0, 1e6)) v.smoothing.beta = *beta;
+    const bool euroKeys = t.get("min_cutoff") || t.get("beta");
+    if (t.get("time_constant_ms") && v.smoothing.kind != Kind::kExponential) {
+      warning(lineOf(*t.get("time_constant_ms")),
+              "viewer.time_constant_ms: only smoothing = \"exponential\" has a time constant; this is ignored");
+    }
+    if (euroKeys && v.smoothing.kind != Kind::kOneEuro) {
+      warning(v.line, "viewer: min_cutoff and beta apply to smoothing = \"one_euro\" only; they are ignored");
+    }
+    if (const toml::node* offset = t.get("tracker_offset")) {
+      if (auto p = point(*offset)) {
+        v.trackerOffset = *p;
+      } else {
+        error(lineOf(*offset), "viewer.tracker_offset: must be a point [x, y, z] in the display geometry's units");
+      }
+    }
+    if (auto scale = number(t, "tracker_scale", "viewer", 1e-6, 1e6)) v.trackerScale = static_cast<float>(*scale);
+    if (v.tracker.empty()) {
+      for (const char* key :
+           {"smoothing", "time_constant_ms", "min_cutoff", "beta", "tracker_offset", "tracker_scale"}) {
+        if (t.get(key)) {
+          warning(lineOf(*t.get(key)), fmt::format("viewer.{}: applies to a tracked viewer; there is no tracker", key));
+        }
+      }
+    }
+    const bool facets =
+        std::ranges::any_of(manifest_.views, [](const ViewSpec& s) { return s.kind == ViewKind::kFacet; });
+    if (!facets) warning(v.line, "viewer: only facet views draw from the viewer; this show has none");
+  }
+
+  /// An array of three finite numbers within a million of zero.
+  static std::optional<std::array<float, 3>> point(const toml::node& node) {
+    const toml::array* a = node.as_array();
+    if (!a || a->size() != 3) return std::nullopt;
+    std::array<float, 3> values{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      const toml::node* element = a->get(i);
+      const auto n = element ? element->value<double>() : std::nullopt;
+      if (!n || !std::isfinite(*n) || std::abs(*n) > 1e6) return std::nullopt;
+      values[i] = static_cast<float>(*n);
+    }
+    return values;
+  }
+
   void readFrom(const toml::node& node, const std::string& path, ViewSpec& v) {
     const toml::array* a = node.as_array();
     std::array<float, 3> values{};
@@ -1229,10 +1317,13 @@ class Reader {
       d.line = lineOf(*t);
       checkKeys(*t, path,
                 {"kind", "backend", "match", "trace", "script", "loop", "required", "size", "gain", "acceleration",
-                 "mirror", "faults", "format", "midi"});
-      const auto kind =
-          choice<DeviceKind>(*t, "kind", path, {{"dial_box", DeviceKind::kDialBox}, {"camera", DeviceKind::kCamera}});
-      if (!t->get("kind")) error(d.line, fmt::format("{}: needs kind = \"dial_box\" or \"camera\"", path));
+                 "mirror", "faults", "format", "midi", "motion", "radius", "period", "rate", "centre"});
+      const auto kind = choice<DeviceKind>(
+          *t, "kind", path,
+          {{"dial_box", DeviceKind::kDialBox}, {"camera", DeviceKind::kCamera}, {"tracker", DeviceKind::kTracker}});
+      if (!t->get("kind")) {
+        error(d.line, fmt::format("{}: needs kind = \"dial_box\", \"camera\" or \"tracker\"", path));
+      }
       if (kind) d.kind = *kind;
       const auto backend = choice<DeviceBackend>(*t, "backend", path,
                                                  {{"hid", DeviceBackend::kHid},
@@ -1254,12 +1345,15 @@ class Reader {
                                  *backend == DeviceBackend::kMidi;
         const bool cameraBackend =
             *backend != DeviceBackend::kHid && *backend != DeviceBackend::kSerial && *backend != DeviceBackend::kMidi;
-        if ((*kind == DeviceKind::kDialBox && !dialBackend) || (*kind == DeviceKind::kCamera && !cameraBackend)) {
+        const bool trackerBackend = *backend == DeviceBackend::kHid || *backend == DeviceBackend::kReplay ||
+                                    *backend == DeviceBackend::kSynthetic;
+        if ((*kind == DeviceKind::kDialBox && !dialBackend) || (*kind == DeviceKind::kCamera && !cameraBackend) ||
+            (*kind == DeviceKind::kTracker && !trackerBackend)) {
           error(lineOf(*t->get("backend")),
-                fmt::format(
-                    "{}: a {} cannot use the {} backend; a dial_box uses hid, serial, midi, replay or synthetic, a "
-                    "camera v4l2, libcamera, replay or synthetic",
-                    path, deviceKindName(*kind), deviceBackendName(*backend)));
+                fmt::format("{}: a {} cannot use the {} backend; a dial_box uses hid, serial, midi, replay or "
+                            "synthetic, a camera v4l2, libcamera, replay or synthetic, a tracker hid, replay or "
+                            "synthetic",
+                            path, deviceKindName(*kind), deviceBackendName(*backend)));
         }
       }
       if (const toml::table* m = table(*t, "match", path)) readMatch(*m, path + ".match", d);
@@ -1356,6 +1450,7 @@ class Reader {
           warning(lineOf(*t->get(key)), fmt::format("{}.{}: only dial boxes have one; this is ignored", path, key));
         }
       }
+      readTrackerMotion(*t, path, d);
       manifest_.devices.push_back(std::move(d));
     }
   }
@@ -1411,6 +1506,32 @@ class Reader {
       return;
     }
     d.midi = std::move(options);
+  }
+
+  void readTrackerMotion(const toml::table& t, const std::string& path, DeviceSpec& d) {
+    TrackerMotion& m = d.motion;
+    if (auto shape = choice<TrackerMotion::Shape>(t, "motion", path,
+                                                  {{"circle", TrackerMotion::Shape::kCircle},
+                                                   {"line", TrackerMotion::Shape::kLine},
+                                                   {"figure_eight", TrackerMotion::Shape::kFigureEight}})) {
+      m.shape = *shape;
+    }
+    if (auto radius = number(t, "radius", path, 0, 100)) m.radius = static_cast<float>(*radius);
+    if (auto period = number(t, "period", path, 0.01, 3600)) m.period = *period;
+    if (auto rate = integer(t, "rate", path, 1, 2000)) m.rate = static_cast<std::uint32_t>(*rate);
+    if (const toml::node* centre = t.get("centre")) {
+      if (auto p = point(*centre)) {
+        m.centre = *p;
+      } else {
+        error(lineOf(*centre), fmt::format("{}.centre: must be a point [x, y, z] in metres", path));
+      }
+    }
+    for (const char* key : {"motion", "radius", "period", "rate", "centre"}) {
+      if (t.get(key) && (d.kind != DeviceKind::kTracker || d.backend != DeviceBackend::kSynthetic)) {
+        warning(lineOf(*t.get(key)),
+                fmt::format("{}.{}: only synthetic trackers move by themselves; this is ignored", path, key));
+      }
+    }
   }
 
   void readMatch(const toml::table& m, const std::string& path, DeviceSpec& d) {

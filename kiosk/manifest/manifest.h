@@ -22,6 +22,7 @@
 #include "runtime/clock.h"
 #include "runtime/error.h"
 #include "runtime/formats/cave.h"
+#include "runtime/head_tracking.h"
 
 namespace basalt::kiosk {
 
@@ -114,6 +115,21 @@ struct ViewSpec {
   std::optional<std::array<float, 3>> from;  ///< aids: direction the display is seen from (cave axes)
 };
 
+/// \brief `[viewer]`: where an immersive display's viewer is (thesis §4.4.3: every facet's
+/// frustum runs from the viewer's eye to the facet), in the display geometry's units with the
+/// display centre (the cave's origin) as the origin.
+struct ViewerSpec {
+  std::array<float, 3> position{};  ///< the point between the eyes, when no tracker moves it
+  /// A `[devices]` tracker that moves the viewer (empty: it stays at `position`).
+  std::string tracker;
+  runtime::HeadSmoothing smoothing;  ///< how its samples are smoothed
+  /// Where the tracker's origin is (display units) and display units per tracker unit (metres
+  /// for trackers that state their units).
+  std::array<float, 3> trackerOffset{};
+  float trackerScale = 1.0f;
+  int line = 0;
+};
+
 /// \brief What a show entry, playlist item or standby item plays.
 enum class EntryKind : std::uint8_t {
   kBuiltinDefault,  ///< "default": LAVA's start-up cube, built in
@@ -157,7 +173,7 @@ struct MediaSpec {
   int line = 0;
 };
 
-enum class DeviceKind : std::uint8_t { kDialBox, kCamera };
+enum class DeviceKind : std::uint8_t { kDialBox, kCamera, kTracker };
 enum class DeviceBackend : std::uint8_t { kHid, kV4l2, kLibcamera, kReplay, kSynthetic, kSerial, kMidi };
 std::string_view deviceKindName(DeviceKind kind);
 std::string_view deviceBackendName(DeviceBackend backend);
@@ -190,6 +206,17 @@ struct SyntheticFault {
   Nanos duration{0};  ///< signal_lost and stall
 };
 
+/// \brief Where a synthetic tracker moves (sim::TrackerPath): `motion`, `radius` (metres),
+/// `period` (seconds a lap), `rate` (samples a second), `centre` ([x, y, z] metres).
+struct TrackerMotion {
+  enum class Shape : std::uint8_t { kCircle, kLine, kFigureEight };
+  Shape shape = Shape::kCircle;
+  float radius = 0.3f;
+  double period = 4;
+  std::uint32_t rate = 90;
+  std::array<float, 3> centre{};
+};
+
 /// \brief `[devices.NAME]`.
 struct DeviceSpec {
   std::string name;
@@ -210,6 +237,7 @@ struct DeviceSpec {
   /// midi dial box: `midi = { profile, encoding, channel, dials, buttons, notes, nrpn,
   /// high_resolution, echo }` as the backend's options (devices/midi/midi_backend.h), checked
   std::map<std::string, std::string> midi;
+  TrackerMotion motion;                ///< synthetic tracker: its path
   int line = 0;
 };
 
@@ -445,6 +473,7 @@ struct Manifest {
   EntrySpec entry;
   OutputSpec output;
   std::vector<ViewSpec> views;
+  ViewerSpec viewer;  ///< the viewer of the facet views
   std::vector<MediaSpec> media;
   std::vector<DeviceSpec> devices;
   std::vector<BindingSpec> bindings;

@@ -78,6 +78,15 @@ Result<std::vector<DeviceId>> DeviceWiring::addReplay(const std::filesystem::pat
   manager_.addProvider(std::move(provider));
   std::vector<DeviceId> ids;
   for (auto& r : requests) {
+    if (r.kind == devices::DeviceKind::kTracker) {
+      // A replayed head moves a show's viewer only where the manifest says which tracker it follows.
+      log::warn(kLogWiring,
+                "{}: '{}' is a tracker, which --replay does not play; to move the facet views' viewer with it, "
+                "add it to the show's [devices] (kind = \"tracker\", backend = \"replay\") and name it in "
+                "[viewer] tracker",
+                path.string(), r.name);
+      continue;
+    }
     r.options["loop"] = loop ? "true" : "false";
     auto id = manager_.request(r);
     if (!id) return std::unexpected(id.error());

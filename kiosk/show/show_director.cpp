@@ -96,6 +96,13 @@ void ShowDirector::takeOver(std::unique_ptr<LoadedShow> show, Nanos now, const s
   const WallTime wall = context_.clock.wallNow();
   for (DeviceSlot& slot : show_->devices) slot.since = wall;
   requestDevices();
+  // The facet views' viewer follows the show's tracker; without one it stands where the views
+  // put it (a follower's comes from the leader with every frame).
+  head_.reset();
+  headFrames_ = 0;
+  if (!follower_ && !show_->manifest.viewer.tracker.empty()) head_.emplace(show_->manifest.viewer);
+  if (!follower_) context_.show.head() = {};
+  context_.board.publishTracker(head_ ? &head_->figures() : nullptr);
   for (LoadedTexture& t : show_->textures) {
     if (t.image) {
       if (auto r = context_.renderer.textures().setImage(t.name, *t.image); !r) {
@@ -139,6 +146,11 @@ void ShowDirector::requestDevices() {
     const bool camera = slot.spec.kind == DeviceKind::kCamera;
     // A camera opens only when a texture shows it (or the scripts' VCR asks for it).
     if (camera && !cameraShown(slot.spec.name)) continue;
+    // A follower draws the leader's viewer: its own tracker stays closed.
+    if (follower_ && slot.spec.kind == DeviceKind::kTracker) {
+      slot.message = "not read on a frame-locked follower: the leader's viewer is drawn";
+      continue;
+    }
     const std::string name = slot.spec.name;
     auto id = devices_->request(std::move(slot.source.request), std::move(slot.source.provider), slot.source.upkeep);
     // The scripts' VCR may hold the camera already: the show shares it.
@@ -685,6 +697,13 @@ Result<void> ShowDirector::beforeDraw(const FrameContext& frame) {
   const Nanos now = frame.time;
   serviceDevices(now);
   applyInput(now);
+  if (head_ && !follower_) {
+    head_->update(now, *devices_, context_.show);
+    if (head_->figures().frames != headFrames_) {
+      headFrames_ = head_->figures().frames;
+      context_.board.publishTracker(&head_->figures());
+    }
+  }
   applyOutputInput(now);
   advanceShuttles(now);
   // A frame-locked follower's programme is the leader's (followProgramme): it decides nothing.
@@ -790,6 +809,15 @@ void ShowDirector::setLocked(bool leader, std::chrono::milliseconds patience) {
   locked_ = true;
   follower_ = !leader;
   patience_ = patience;
+  if (follower_ && head_) {
+    // The show was loaded before the lock: the follower's tracker goes, the leader's head comes.
+    log::info(kLogDirector, "tracker '{}' is not read on a frame-locked follower: the leader's viewer is drawn",
+              head_->tracker());
+    devices_->withdraw(head_->tracker());
+    std::erase(requested_, head_->tracker());
+    head_.reset();
+    context_.board.publishTracker(nullptr);
+  }
   if (show_) alignStreams();
   // A leader's movie item that started with the show (before the lock) starts again on the
   // group's timeline, from the item's start: the followers place theirs there.

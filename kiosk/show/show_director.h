@@ -26,6 +26,7 @@
 #include "kiosk/policy/kiosk_policy.h"
 #include "kiosk/policy/state_store.h"
 #include "kiosk/policy/supervisor.h"
+#include "kiosk/show/head_follower.h"
 #include "kiosk/show/show_loader.h"
 #include "kiosk/status/status_board.h"
 #include "render/output.h"
@@ -187,6 +188,8 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   std::unique_ptr<LoadedShow> show_;
   std::unique_ptr<devices::UdevMonitor> udev_;  // a device came: retry the absent at once
   std::unique_ptr<KioskPolicy> policy_;
+  std::optional<HeadFollower> head_;  // the viewer's tracker ([viewer] tracker), if any
+  std::uint64_t headFrames_ = 0;      // head_->figures().frames last published
   std::shared_ptr<const Schedule> scheduleForStatus_;
   ItemPlayer* player_ = nullptr;  // the playing item's player, owned by show_
   std::uint64_t appliedGeneration_ = 0;

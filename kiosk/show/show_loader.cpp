@@ -32,12 +32,33 @@ DeviceSource syntheticDialBox(const DeviceSpec& spec) {
   return source;
 }
 
+/// A synthetic tracker moving along the manifest's path, in a backend of its own.
+DeviceSource syntheticTracker(const DeviceSpec& spec) {
+  sim::SyntheticProvider::Device device;
+  device.candidate = {sim::SyntheticTracker::defaultInfo(), devices::DeviceKind::kTracker, "", "the manifest's path"};
+  const TrackerMotion& m = spec.motion;
+  sim::TrackerPath& path = device.tracker;
+  path.shape = m.shape == TrackerMotion::Shape::kLine          ? sim::TrackerPath::Shape::kLine
+               : m.shape == TrackerMotion::Shape::kFigureEight ? sim::TrackerPath::Shape::kFigureEight
+                                                               : sim::TrackerPath::Shape::kCircle;
+  path.radius = m.radius;
+  path.period = Nanos{static_cast<std::int64_t>(m.period * 1e9)};
+  path.rate = m.rate;
+  path.centre = {m.centre[0], m.centre[1], m.centre[2]};
+  DeviceSource source;
+  source.provider = std::make_unique<sim::SyntheticProvider>(std::vector{std::move(device)});
+  source.request.kind = devices::DeviceKind::kTracker;
+  source.request.match.backend = "synthetic";
+  return source;
+}
+
 Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec, const ShowFactories& factories) {
   const bool dialBox = spec.kind == DeviceKind::kDialBox;
   if (dialBox && spec.backend == DeviceBackend::kSynthetic) return syntheticDialBox(spec);
+  if (spec.kind == DeviceKind::kTracker && spec.backend == DeviceBackend::kSynthetic) return syntheticTracker(spec);
   if (factories.devices) return factories.devices(spec);
   return fail(Errc::kUnsupported, fmt::format("this build has no {} {} backend", deviceBackendName(spec.backend),
-                                              dialBox ? "dial box" : "camera"));
+                                              deviceKindName(spec.kind)));
 }
 
 /// The factory for the texture stream of `kind` (movies and cameras); null for images.

@@ -682,6 +682,11 @@ Result<DeviceSource> makeDeviceSource(const DeviceSpec& spec) {
   source.provider = std::move(*provider);
   if (spec.kind == DeviceKind::kCamera) {
     source.request = cameraRequest(spec);
+  } else if (spec.kind == DeviceKind::kTracker) {
+    source.request.name = spec.name;
+    source.request.kind = devices::DeviceKind::kTracker;
+    source.request.match = deviceMatchFor(spec);
+    source.request.options["loop"] = spec.loop ? "true" : "false";
   } else {
     auto request = dialBoxRequest(spec);
     if (!request) return std::unexpected(request.error());

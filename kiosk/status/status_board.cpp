@@ -142,6 +142,24 @@ void StatusBoard::publishLock(const FrameLockFigures& figures) {
   lock_ = figures;
 }
 
+void StatusBoard::publishTracker(const TrackerFigures* figures) {
+  std::lock_guard lock(mutex_);
+  if (!figures) {
+    tracker_.reset();
+  } else if (tracker_) {
+    // Field by field into the one kept: the name's storage is reused, so a frame allocates nothing.
+    tracker_->tracker.assign(figures->tracker);
+    tracker_->samples = figures->samples;
+    tracker_->dropped = figures->dropped;
+    tracker_->lastLatency = figures->lastLatency;
+    tracker_->maxLatency = figures->maxLatency;
+    tracker_->latencySum = figures->latencySum;
+    tracker_->frames = figures->frames;
+  } else {
+    tracker_ = *figures;
+  }
+}
+
 void StatusBoard::setNominalFps(double fps) {
   std::lock_guard lock(mutex_);
   nominalFps_ = fps;
@@ -285,6 +303,7 @@ StatusSnapshot StatusBoard::snapshot(WallTime now) const {
     s.performance = performance_;
     s.lock = lock_;
     s.osc = osc_;
+    s.tracker = tracker_;
   }
   if (s.show.schedule)
     s.show.nextScheduleChange = s.show.schedule->nextChange(showClock_ ? showClock_->wallNow() : now);

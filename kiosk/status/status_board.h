@@ -73,6 +73,19 @@ inline constexpr std::array<double, 14> kFrameIntervalBuckets{0.005, 0.01,   0.0
 /// \brief A count per bucket of kFrameIntervalBuckets.
 using IntervalBuckets = std::array<std::uint64_t, kFrameIntervalBuckets.size()>;
 
+/// \brief A tracked viewer's figures (`[viewer] tracker`), published every frame it moves.
+struct TrackerFigures {
+  std::string tracker;        ///< the device's name in the manifest
+  std::uint64_t samples = 0;  ///< samples applied
+  std::uint64_t dropped = 0;  ///< samples dropped before the frame loop took them
+  /// Sample time to the frame that first draws with it (show clock): the newest sample a frame
+  /// uses, against the frame's time. Zero until a sample arrives.
+  Nanos lastLatency{0};
+  Nanos maxLatency{0};
+  double latencySum = 0;     ///< seconds, over `frames`
+  std::uint64_t frames = 0;  ///< frames that took new samples
+};
+
 /// \brief Figures derived from the recent frames, and totals since the start.
 struct FrameFigures {
   std::int64_t frames = 0;
@@ -147,6 +160,7 @@ struct StatusSnapshot {
   runtime::PerformanceMeter performance;  ///< LAVA's meter, as last sampled (updates == 0: not yet)
   std::optional<FrameLockFigures> lock;   ///< a frame-locked node's figures ([lock]); none otherwise
   std::optional<OscFigures> osc;          ///< the OSC input's and output's counts ([osc]); none otherwise
+  std::optional<TrackerFigures> tracker;  ///< a tracked viewer's figures; none without one
   // Filled by the status server when it reports, not by the board:
   std::optional<ProcessFigures> process;  ///< the process's own figures
   std::optional<ServerFacts> server;      ///< the server's set-up (/health)
@@ -241,6 +255,8 @@ class StatusBoard {
   void publishPerformance(const runtime::PerformanceMeter& meter);
   /// \brief A frame-locked node's figures (kiosk/lock/frame_lock.h).
   void publishLock(const FrameLockFigures& figures);
+  /// \brief A tracked viewer's figures (kiosk/show/head_follower.h); null clears them.
+  void publishTracker(const TrackerFigures* figures);
 
   // ---- any thread ----
   /// \brief The OSC input's counts (its thread publishes them when they change); the sent
@@ -303,6 +319,7 @@ class StatusBoard {
   runtime::PerformanceMeter performance_;   // guarded by mutex_
   std::optional<FrameLockFigures> lock_;    // guarded by mutex_
   std::optional<OscFigures> osc_;           // guarded by mutex_
+  std::optional<TrackerFigures> tracker_;   // guarded by mutex_
   ShowStatus show_;                         // guarded by mutex_
   std::vector<DeviceStatus> devices_;       // guarded by mutex_
   std::vector<StreamStatus> streams_;       // guarded by mutex_

@@ -417,6 +417,23 @@ std::string metricsText(const StatusSnapshot& s, const ServerCounters& server) {
   for (const StreamStatus& st : s.streams) {
     out += fmt::format("basalt_stream_state{{stream=\"{}\"}} {}\n", promLabel(st.name), streamStateNumber(st.state));
   }
+  if (const std::optional<TrackerFigures>& t = s.tracker) {
+    const std::string label = promLabel(t->tracker);
+    metric("basalt_tracker_samples_total", "counter", "Tracker samples the viewer took.");
+    out += fmt::format("basalt_tracker_samples_total{{tracker=\"{}\"}} {}\n", label, t->samples);
+    metric("basalt_tracker_samples_dropped_total", "counter", "Tracker samples dropped before a frame took them.");
+    out += fmt::format("basalt_tracker_samples_dropped_total{{tracker=\"{}\"}} {}\n", label, t->dropped);
+    metric("basalt_tracker_latency_seconds", "summary",
+           "Sample time to the frame that first draws with it (the newest sample a frame uses).");
+    out += fmt::format("basalt_tracker_latency_seconds_sum{{tracker=\"{}\"}} {}\n", label, number(t->latencySum));
+    out += fmt::format("basalt_tracker_latency_seconds_count{{tracker=\"{}\"}} {}\n", label, t->frames);
+    metric("basalt_tracker_latency_last_seconds", "gauge", "The last frame's sample-to-frame latency.");
+    out += fmt::format("basalt_tracker_latency_last_seconds{{tracker=\"{}\"}} {}\n", label,
+                       number(std::chrono::duration<double>(t->lastLatency).count()));
+    metric("basalt_tracker_latency_max_seconds", "gauge", "The largest sample-to-frame latency so far.");
+    out += fmt::format("basalt_tracker_latency_max_seconds{{tracker=\"{}\"}} {}\n", label,
+                       number(std::chrono::duration<double>(t->maxLatency).count()));
+  }
   if (const std::optional<FrameLockFigures>& l = s.lock) {
     const auto lockMetric = [&](std::string_view name, std::string_view type, std::string_view help, auto value) {
       metric(name, type, help);

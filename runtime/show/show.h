@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "runtime/clock.h"
+#include "runtime/head_tracking.h"
 #include "runtime/math.h"
 #include "runtime/show/attributes.h"
 #include "runtime/show/mesh.h"
@@ -199,6 +200,10 @@ class Show {
   /// bounds and speeds) as a `.sce` scene sets it.
   Viewer& viewer() { return viewer_; }
   [[nodiscard]] const Viewer& viewer() const { return viewer_; }
+  /// \brief The tracked head of an immersive display's viewer (display units), when a tracker
+  /// drives it: the facet views draw from it instead of their fixed viewer.
+  HeadPose& head() { return head_; }
+  [[nodiscard]] const HeadPose& head() const { return head_; }
   PerformanceMeter& performance() { return performance_; }
   [[nodiscard]] const PerformanceMeter& performance() const { return performance_; }
 
@@ -256,6 +261,7 @@ class Show {
   EarthSky earthSky_;
   StereoSettings stereo_;
   Viewer viewer_;
+  HeadPose head_;
   PerformanceMeter performance_;
   std::uint64_t frameNumber_ = 0;
 };

@@ -53,6 +53,8 @@ FrameMessage sampleFrame() {
   show.view().perspective = 2.5f;
   show.viewer().position = {4, 1.7f, -3};
   show.viewer().rotation = {0, 45, 0};
+  // A tracked head off the display's centre, turned a little (version 4).
+  show.head() = {true, {0.3f, -0.2f, 0.55f}, {0.96f, 0, 0.28f}, Nanos{20'550'000'000}};
   m.state = captureLockedState(show);
   m.programme.present = true;
   m.programme.hasItem = true;
@@ -169,7 +171,7 @@ TEST(LockProtocol, MalformedMessagesAreRejectedWithTheReason) {
   bad[4] = std::byte{2};  // a basalt from before the commands were sent
   auto version = decodeFrame(bytesOf(bad, n));
   ASSERT_FALSE(version);
-  EXPECT_NE(version.error().message().find("version 2, this basalt speaks version 3"), std::string::npos)
+  EXPECT_NE(version.error().message().find("version 2, this basalt speaks version 4"), std::string::npos)
       << version.error().message();
 
   bad = b;
@@ -283,7 +285,7 @@ TEST(LockProtocol, MovieFramesRoundTripAndBadOnesAreRejected) {
   ASSERT_TRUE(back) << back.error().message();
   EXPECT_EQ(back->movies, sampleFrame().movies);
 
-  constexpr std::size_t kMoviesAt = kFrameMessageBytes - kLockedMovieFramesBytes;
+  constexpr std::size_t kMoviesAt = kFrameMessageBytes - kLockedHeadBytes - kLockedMovieFramesBytes;
   const auto rejects = [&](FrameMessage m, std::string_view why) {
     LockBuffer bad{};
     auto d = decodeFrame(bytesOf(bad, encode(m, bad)));
@@ -305,7 +307,7 @@ TEST(LockProtocol, MovieFramesRoundTripAndBadOnesAreRejected) {
   back = decodeFrame(bytesOf(b, encode(withSession, b)));
   ASSERT_TRUE(back) << back.error().message();
   EXPECT_EQ(back->session, 0xB45A17U);
-  static_assert(kMoviesAt + 4 + 4 * kLockedMovieStreams + 4 == kFrameMessageBytes);
+  static_assert(kMoviesAt + 4 + 4 * kLockedMovieStreams + 4 + kLockedHeadBytes == kFrameMessageBytes);
 }
 
 // Makes sure the leader's log numbers commands from 1, keeps the newest kKept, and starts again

@@ -71,6 +71,41 @@ TEST_F(DisplayViewsTest, SixFacetsTiledInOneOutput) {
   }
 }
 
+// Makes sure a facet view draws from the viewer it is given (`[viewer] position`) and, while the
+// Show's head is tracked, from the head instead, in the display's units placed in the world.
+// Example failures: the viewer set but the frusta still drawn from the display's centre; a
+// tracked head ignored; a head that is no longer tracked still drawn from.
+TEST_F(DisplayViewsTest, FacetViewsDrawFromTheViewerAndFromATrackedHead) {
+  kiosk::ViewSpec front;
+  front.name = "front";
+  front.kind = kiosk::ViewKind::kFacet;
+  front.cave = folder_ / "display.cave";  // facet[5]
+  auto views = kiosk::DisplayViews::create({front}, renderer(), output().size());
+  ASSERT_TRUE(views) << views.error().describe();
+  runtime::Show show = runtime::Show::makeDefault();
+  const Mat4 placement = runtime::cavePlacement(show);
+  const auto eyeAt = [&](const Vec3& v) { return placement.transformPoint(v); };
+  const auto sameAs = [](const Vec3& a, const Vec3& b) { return length(a - b) < 1e-5f; };
+
+  const Image centre = draw(**views, show);
+  EXPECT_TRUE(sameAs((*views)->lastProjection(0)->eye, eyeAt({0, 0, 0})));
+
+  (*views)->setViewer({0.3f, -0.2f, 0.1f});
+  const Image aside = draw(**views, show);
+  EXPECT_TRUE(sameAs((*views)->lastProjection(0)->eye, eyeAt({0.3f, -0.2f, 0.1f})));
+  EXPECT_NE(centre.pixels, aside.pixels) << "the picture follows the viewer";
+
+  show.head() = {true, {-0.4f, 0.1f, 0.2f}, {1, 0, 0}, Nanos{0}};
+  const Image tracked = draw(**views, show);
+  EXPECT_TRUE(sameAs((*views)->lastProjection(0)->eye, eyeAt({-0.4f, 0.1f, 0.2f}))) << "the tracked head wins";
+  EXPECT_NE(tracked.pixels, aside.pixels);
+
+  show.head().tracked = false;
+  const Image back = draw(**views, show);
+  EXPECT_TRUE(sameAs((*views)->lastProjection(0)->eye, eyeAt({0.3f, -0.2f, 0.1f})));
+  EXPECT_EQ(back.pixels, aside.pixels) << "the same viewer draws the same picture";
+}
+
 TEST_F(DisplayViewsTest, CalibrationChangesLiveAndIsSavedToTheCaveFile) {
   kiosk::ViewSpec one;
   one.name = "front";

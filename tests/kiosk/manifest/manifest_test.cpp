@@ -791,6 +791,56 @@ TEST(ManifestErrors, FacetWindingIsOneOfThreeWithSuggestions) {
   EXPECT_TRUE(hasWarning(bad, 11, "views[2]: winding applies to facet views only")) << bad.text;
 }
 
+// Makes sure `[viewer]` places the facet views' viewer and names a tracker that moves it, with
+// its smoothing, and that `basalt check` says what is wrong with each key. Example failures: a
+// viewer tracker naming a dial box accepted (the viewer never moves); a time constant given to
+// the one-euro filter silently ignored; a synthetic tracker's path read as a dial box's.
+TEST(ManifestErrors, TheViewerStandsWhereItIsPutAndFollowsATracker) {
+  ShowFolder f("viewer");
+  const auto ok = f.read(
+      "[[views]]\nname = \"a\"\nkind = \"facet\"\ncave = \"room.cave\"\n"
+      "[viewer]\nposition = [0.1, -0.2, 0.3]\ntracker = \"head\"\nsmoothing = \"exponential\"\n"
+      "time_constant_ms = 80\ntracker_offset = [0, -1.6, 0]\ntracker_scale = 0.001\n"
+      "[devices.head]\nkind = \"tracker\"\nbackend = \"synthetic\"\nmotion = \"figure_eight\"\nradius = 0.4\n"
+      "period = 6\nrate = 120\ncentre = [0, 1.6, 0]\n");
+  ASSERT_TRUE(ok.manifest) << ok.text;
+  const ViewerSpec& v = ok.manifest->viewer;
+  EXPECT_EQ(v.position, (std::array<float, 3>{0.1f, -0.2f, 0.3f}));
+  EXPECT_EQ(v.tracker, "head");
+  EXPECT_EQ(v.smoothing.kind, runtime::HeadSmoothing::Kind::kExponential);
+  EXPECT_EQ(v.smoothing.timeConstant, std::chrono::milliseconds(80));
+  EXPECT_EQ(v.trackerOffset, (std::array<float, 3>{0, -1.6f, 0}));
+  EXPECT_FLOAT_EQ(v.trackerScale, 0.001f);
+  const DeviceSpec* head = ok.manifest->findDevice("head");
+  ASSERT_NE(head, nullptr);
+  EXPECT_EQ(head->kind, DeviceKind::kTracker);
+  EXPECT_EQ(head->motion.shape, TrackerMotion::Shape::kFigureEight);
+  EXPECT_FLOAT_EQ(head->motion.radius, 0.4f);
+  EXPECT_DOUBLE_EQ(head->motion.period, 6);
+  EXPECT_EQ(head->motion.rate, 120u);
+
+  const auto bad = f.read(
+      "[[views]]\nname = \"a\"\nkind = \"facet\"\ncave = \"room.cave\"\n"            // 1-4
+      "[viewer]\nposition = [0, 0]\ntracker = \"dials\"\n"                           // 5-7
+      "min_cutoff = 2\nsmoothing = \"exponential\"\n"                                // 8-9
+      "[devices.dials]\nkind = \"dial_box\"\nbackend = \"synthetic\"\nradius = 1\n"  // 10-13
+      "[devices.cam]\nkind = \"tracker\"\nbackend = \"v4l2\"\n");                    // 14-16
+  EXPECT_FALSE(bad.manifest);
+  EXPECT_TRUE(hasError(bad, 6, "viewer.position: must be a point [x, y, z] in the display geometry's units"))
+      << bad.text;
+  EXPECT_TRUE(hasError(bad, 7, "viewer.tracker: 'dials' is a dial_box, not a tracker")) << bad.text;
+  EXPECT_TRUE(hasWarning(bad, 5, "viewer: min_cutoff and beta apply to smoothing = \"one_euro\" only")) << bad.text;
+  EXPECT_TRUE(hasWarning(bad, 13, "devices.dials.radius: only synthetic trackers move by themselves")) << bad.text;
+  EXPECT_TRUE(hasError(bad, 16, "devices.cam: a tracker cannot use the v4l2 backend")) << bad.text;
+
+  const auto noFacets = f.read("[viewer]\nposition = [0, 0, 1]\nbeta = 1\n");
+  ASSERT_TRUE(noFacets.manifest) << noFacets.text;
+  EXPECT_TRUE(hasWarning(noFacets, 1, "viewer: only facet views draw from the viewer; this show has none"))
+      << noFacets.text;
+  EXPECT_TRUE(hasWarning(noFacets, 3, "viewer.beta: applies to a tracked viewer; there is no tracker"))
+      << noFacets.text;
+}
+
 TEST(ManifestErrors, AnEmptyManifestPlaysTheDefaultShow) {
   ShowFolder f("empty");
   const auto r = f.read("");

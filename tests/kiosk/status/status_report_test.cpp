@@ -182,8 +182,38 @@ StatusSnapshot everything(bool leader) {
   lock.clockOffsetUs = -35;
   lock.barrierWaitP50Ms = 1.5;
   s.lock = lock;
+  TrackerFigures tracker;
+  tracker.tracker = "head";
+  tracker.samples = 900;
+  tracker.dropped = 3;
+  tracker.lastLatency = std::chrono::milliseconds(7);
+  tracker.maxLatency = std::chrono::milliseconds(16);
+  tracker.latencySum = 4.5;
+  tracker.frames = 600;
+  s.tracker = tracker;
   s.process = readProcessFigures();
   return s;
+}
+
+// Makes sure a tracked viewer's sample-to-frame latency reaches /metrics in seconds, with its
+// counts, labelled by the tracker's name, and that a show without one has none of it. Example
+// failure: latency in nanoseconds under a _seconds name.
+TEST(StatusMetrics, TheTrackedViewersLatencyIsPublished) {
+  const std::string text = metricsText(everything(true), {});
+  EXPECT_NEAR(test::metric(text, "basalt_tracker_latency_last_seconds{tracker=\"head\"}").value_or(-1), 0.007, 1e-9)
+      << text;
+  EXPECT_NEAR(test::metric(text, "basalt_tracker_latency_max_seconds{tracker=\"head\"}").value_or(-1), 0.016, 1e-9)
+      << text;
+  EXPECT_NEAR(test::metric(text, "basalt_tracker_latency_seconds_sum{tracker=\"head\"}").value_or(-1), 4.5, 1e-9)
+      << text;
+  EXPECT_NEAR(test::metric(text, "basalt_tracker_latency_seconds_count{tracker=\"head\"}").value_or(-1), 600.0, 1e-9)
+      << text;
+  EXPECT_NEAR(test::metric(text, "basalt_tracker_samples_total{tracker=\"head\"}").value_or(-1), 900.0, 1e-9) << text;
+  EXPECT_NEAR(test::metric(text, "basalt_tracker_samples_dropped_total{tracker=\"head\"}").value_or(-1), 3.0, 1e-9)
+      << text;
+  StatusSnapshot none = everything(true);
+  none.tracker.reset();
+  EXPECT_EQ(metricsText(none, {}).find("basalt_tracker"), std::string::npos);
 }
 
 /// `promtool check metrics` on `text`: its output, and whether it found nothing to say.
