@@ -657,6 +657,7 @@ void applyScene(runtime::Show& show, const LoadedScene& scene, std::vector<Diagn
   show.stereo().units = runtime::Units::kScene;
   runtime::Viewer& v = show.viewer();
   v.fromScene = true;
+  v.framing = runtime::Framing::kScene;
   v.position = d.position;
   v.rotation = d.rotation;
   v.fieldOfView = d.fieldOfView;
@@ -674,6 +675,13 @@ void applyScene(runtime::Show& show, const LoadedScene& scene, std::vector<Diagn
     v.viewportHeight = (*d.viewport)[3];
   }
   v.followTerrain = !scene.terrains.empty();
+}
+
+void useFitFraming(runtime::Show& show) {
+  runtime::Viewer& v = show.viewer();
+  v.framing = runtime::Framing::kFit;
+  v.position = {0, 0, 0};
+  v.rotation = {0, 0, 0};
 }
 
 // ---- Writing -------------------------------------------------------------------------------------
