@@ -129,8 +129,12 @@ std::optional<std::size_t> DisplayViews::facetViewNamed(const std::string& of) c
 runtime::FacetViewInput DisplayViews::facetInput(const View& v, const runtime::Show& show) {
   runtime::FacetViewInput input;
   input.calibration = v.cave.settings;
-  input.worldFromCave = runtime::cavePlacement(show);
-  input.farDistance = show.viewer().farClip;
+  // The camera places the display (thesis §4.4.4); the manifest says where it stands from the
+  // camera and how many scene units one of its units is.
+  input.worldFromCave = runtime::cavePlacement(show) *
+                        Mat4::translation({v.spec.displayAt[0], v.spec.displayAt[1], v.spec.displayAt[2]}) *
+                        Mat4::scaling({v.spec.displayScale, v.spec.displayScale, v.spec.displayScale});
+  input.farDistance = show.viewer().farClip / v.spec.displayScale;  // the facet's eye space is in cave units
   input.rearProjection = v.spec.rearProjection;
   return input;
 }

@@ -1,0 +1,170 @@
+// A facet display standing in a real-size scene (thesis §4.4.4: "the camera is used to position
+// and orient the display geometry relative to the virtual world. Then the viewer is translated
+// and rotated relative to the display geometry"; §4.4: "A viewing frustum is created such that
+// the near clipping plane is coincident with the facet [...] No geometry inside the display
+// geometry will be visible"). The scene's camera places the display; the manifest's
+// `display_scale` says how many scene units one unit of the display geometry is and
+// `display_at` where the display's origin (the viewer) stands from the camera, in the camera's
+// axes.
+//
+// The display is the test cube (walls one cave unit from its centre), seen through its front
+// wall (facet 5, facing the camera's -Z): a square facet at distance 1 whose half-width is 1,
+// so it fills the 256 x 256 view and a point at angle a from the line of sight lands
+// 128 tan(a) pixels from the centre. The facet may turn and mirror its picture (base side,
+// rear projection), so the checks use distances from the centre only.
+//
+// Example failures: the display placed in LAVA's window units (objects ten scene units away
+// squeezed to the centre); display_scale ignored (an object between the viewer and the facet
+// drawn); display_at ignored (the eye left at the camera).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "kiosk/loop/display_views.h"
+#include "runtime/formats/scene.h"
+#include "support/polyhedra.h"
+#include "support/render_fixture.h"
+#include "support/test_paths.h"
+
+namespace basalt::test {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Blob {
+  std::size_t pixels = 0;
+  double x = 0, y = 0;  ///< centroid, pixel centres, from the image's centre
+  [[nodiscard]] double radius() const { return std::hypot(x, y); }
+};
+
+/// The pixels where channel `c` is bright.
+Blob blob(const Image& image, std::uint32_t c) {
+  Blob b;
+  for (std::uint32_t y = 0; y < image.height; ++y) {
+    for (std::uint32_t x = 0; x < image.width; ++x) {
+      if (image.at(x, y, c) < 128) continue;
+      ++b.pixels;
+      b.x += x + 0.5 - image.width / 2.0;
+      b.y += y + 0.5 - image.height / 2.0;
+    }
+  }
+  if (b.pixels > 0) b.x /= static_cast<double>(b.pixels), b.y /= static_cast<double>(b.pixels);
+  return b;
+}
+
+std::string cubeObj(const std::string& name, double cx, double cy, double cz, double h) {
+  std::string obj = "o " + name + "\n";
+  for (int i = 0; i < 8; ++i) {
+    obj += fmt::format("v {} {} {}\n", cx + ((i & 1) ? h : -h), cy + ((i & 2) ? h : -h), cz + ((i & 4) ? h : -h));
+  }
+  obj += "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+  return obj;
+}
+
+class SceneDisplay : public RenderTest {
+ protected:
+  void SetUp() override {
+    RenderTest::SetUp();
+    if (IsSkipped()) return;
+    folder_ = scratchDir(std::string("scene_display-") + testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::ofstream(folder_ / "display.obj") << cubeDisplayObj();
+    std::ofstream(folder_ / "display.cave") << "model display.obj\nfacet[5]\n";
+  }
+
+  /// The camera's axes for position[2,1,5] rotation[0,30,0]: turned 30 degrees left about Y.
+  struct Point {
+    double x, y, z;
+  };
+  static Point along(double forward, double right, double up) {
+    const double a = 30 * kPi / 180;
+    // forward (-sin a, 0, -cos a), right (cos a, 0, -sin a), up (0, 1, 0), from (2, 1, 5).
+    return {2 - forward * std::sin(a) + right * std::cos(a), 1 + up, 5 - forward * std::cos(a) - right * std::sin(a)};
+  }
+
+  /// A scene with the camera above and the cubes given (each its own emission colour).
+  runtime::Show scene(const std::vector<std::pair<std::string, std::string>>& cubes) {
+    // Only emission: no light adds to another channel.
+    std::string text =
+        "position[2,1,5]\nrotation[0,30,0]\nprojection fov[60] nearclip[0.1] farclip[100]\n"
+        "ambient[0,0,0]\ndiffuse[0,0,0]\nspecular[0,0,0]\n";
+    for (std::size_t i = 0; i < cubes.size(); ++i) {
+      const std::string file = fmt::format("cube{}.obj", i);
+      std::ofstream(folder_ / file) << cubes[i].second;
+      text += fmt::format("emission[{}]\nimport {}\n", cubes[i].first, file);
+    }
+    std::ofstream(folder_ / "s.sce") << text;
+    formats::LoadOptions options;
+    options.logWarnings = false;
+    auto loaded = formats::loadScene(folder_ / "s.sce", options);
+    runtime::Show show;
+    EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error().describe());
+    if (loaded) formats::applyScene(show, *loaded);
+    return show;
+  }
+
+  Image draw(const runtime::Show& show, float scale, std::array<float, 3> at = {0, 0, 0}) {
+    kiosk::ViewSpec spec;
+    spec.name = "front";
+    spec.kind = kiosk::ViewKind::kFacet;
+    spec.cave = folder_ / "display.cave";
+    spec.displayScale = scale;
+    spec.displayAt = at;
+    auto views = kiosk::DisplayViews::create({spec}, renderer(), output().size());
+    EXPECT_TRUE(views) << (views ? "" : views.error().describe());
+    Image image;
+    if (!views) return image;
+    EXPECT_TRUE(output().beginFrame());
+    (*views)->drawViews(show, output().size(), {});
+    EXPECT_TRUE(output().readBack(image));
+    return image;
+  }
+
+  std::filesystem::path folder_;
+};
+
+TEST_F(SceneDisplay, ObjectsLandWhereTheFacetsPinholePutsThem) {
+  // Red 10 units straight ahead: the centre. Green 10 ahead and 3 to the right: atan(3 / 10) off
+  // the line of sight, 128 x 0.3 = 38.4 pixels from the centre.
+  const Point red = along(10, 0, 0), green = along(10, 3, 0);
+  const runtime::Show show = scene({{"255,0,0", cubeObj("red", red.x, red.y, red.z, 0.2)},
+                                    {"0,255,0", cubeObj("green", green.x, green.y, green.z, 0.2)}});
+  const Image image = draw(show, 2.0f);
+  const Blob r = blob(image, 0), g = blob(image, 1);
+  ASSERT_GT(r.pixels, 4u) << "the red cube is not in sight";
+  ASSERT_GT(g.pixels, 4u) << "the green cube is not in sight";
+  EXPECT_NEAR(r.radius(), 0.0, 1.0);
+  EXPECT_NEAR(g.radius(), 38.4, 1.0);
+}
+
+TEST_F(SceneDisplay, NothingInsideTheDisplayIsSeen) {
+  // A cube 1.5 units ahead and 0.6 up: inside a display of half-width 2 scene units
+  // (display_scale 2), so clipped; outside one of half-width 1, where it lands
+  // 128 x 0.6 / 1.5 = 51.2 pixels from the centre (its centroid within two pixels).
+  const Point p = along(1.5, 0, 0.6);
+  const runtime::Show show = scene({{"255,255,255", cubeObj("near", p.x, p.y, p.z, 0.1)}});
+  EXPECT_EQ(blob(draw(show, 2.0f), 0).pixels, 0u) << "geometry inside the display was drawn";
+  const Blob seen = blob(draw(show, 1.0f), 0);
+  ASSERT_GT(seen.pixels, 4u);
+  EXPECT_NEAR(seen.radius(), 51.2, 2.0);
+}
+
+TEST_F(SceneDisplay, TheViewerStandsWhereTheDisplayStands) {
+  // display_at [1, 0, 0]: the display, and the viewer at its centre, one unit to the camera's
+  // right. A cube 10 ahead of the camera is then 1 unit to the viewer's left: 12.8 pixels from
+  // the centre; one 10 ahead of the display's centre is at the centre.
+  const Point ahead = along(10, 0, 0), aheadOfDisplay = along(10, 1, 0);
+  const runtime::Show show =
+      scene({{"255,0,0", cubeObj("camera", ahead.x, ahead.y, ahead.z, 0.2)},
+             {"0,255,0", cubeObj("display", aheadOfDisplay.x, aheadOfDisplay.y, aheadOfDisplay.z, 0.2)}});
+  const Image image = draw(show, 1.0f, {1, 0, 0});
+  const Blob r = blob(image, 0), g = blob(image, 1);
+  ASSERT_GT(r.pixels, 4u);
+  ASSERT_GT(g.pixels, 4u);
+  EXPECT_NEAR(r.radius(), 12.8, 1.0);
+  EXPECT_NEAR(g.radius(), 0.0, 1.0);
+}
+
+}  // namespace
+}  // namespace basalt::test
