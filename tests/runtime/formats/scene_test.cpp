@@ -68,9 +68,10 @@ TEST(Scene, CameraValuesThatCannotBeHonouredAreNamedAtTheirLine) {
     EXPECT_NE(warnings[0].message.find(c.says), std::string::npos) << warnings[0].describe();
   }
   std::vector<Diagnostic> none;
-  ASSERT_TRUE(parse("viewport position[0,0] resolution[640,480]\nprojection fov[40] nearclip[0.5] farclip[500]\n"
-                    "mapmin[-10,-10,-10]\nmapmax[10,10,10]\nposition[1,2,3]\n",
-                    none));
+  ASSERT_TRUE(
+      parse("viewport position[0,0] resolution[640,480]\nprojection fov[40] nearclip[0.5] farclip[500]\n"
+            "mapmin[-10,-10,-10]\nmapmax[10,10,10]\nposition[1,2,3]\n",
+            none));
   EXPECT_TRUE(none.empty()) << listWarnings(none);
 }
 
