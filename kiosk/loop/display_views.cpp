@@ -190,6 +190,10 @@ void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
         break;
       }
       case ViewKind::kFacet: {
+        if (!caveMode_) {
+          renderer_.drawShow(show, vp, adjust);
+          break;
+        }
         const formats::CaveGeometry& g = *v.cave.geometry;
         const std::uint32_t index = v.cave.settings.facet < g.facets.size() ? v.cave.settings.facet : 0;
         render::FacetPass pass;

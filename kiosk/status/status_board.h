@@ -132,7 +132,8 @@ struct StatusSnapshot {
 };
 
 /// \brief A request from the control server to the frame loop, answered through `reply`.
-enum class ControlKind : std::uint8_t { kNext, kPrevious, kReload, kRunCommand, kRestartDevice, kCalibrate };
+/// kSetup: one of the thesis' set-up toggles (Appendix B) by name, for kiosks without a keyboard.
+enum class ControlKind : std::uint8_t { kNext, kPrevious, kReload, kRunCommand, kRestartDevice, kCalibrate, kSetup };
 
 struct ControlReply {
   std::mutex mutex;
@@ -148,7 +149,7 @@ struct ControlReply {
 
 struct ControlRequest {
   ControlKind kind = ControlKind::kNext;
-  std::string argument;  ///< the command, the device's name, or calibration statements
+  std::string argument;  ///< the command, the device's name, calibration statements or a set-up toggle
   std::string view;      ///< kCalibrate: the facet view ("" = the first)
   bool save = false;     ///< kCalibrate: write the calibration back to the cave file
   std::shared_ptr<ControlReply> reply;

@@ -24,6 +24,7 @@
 
 #include "kiosk/loop/display_views.h"
 #include "runtime/formats/scene.h"
+#include "runtime/setup_keys.h"
 #include "support/polyhedra.h"
 #include "support/render_fixture.h"
 #include "support/test_paths.h"
@@ -164,6 +165,70 @@ TEST_F(SceneDisplay, TheViewerStandsWhereTheDisplayStands) {
   ASSERT_GT(g.pixels, 4u);
   EXPECT_NEAR(r.radius(), 12.8, 1.0);
   EXPECT_NEAR(g.radius(), 0.0, 1.0);
+}
+
+// Appendix B's set-up toggles change the picture drawn (and a second press brings it back):
+// fog, lighting, smooth shading, filled / points / wireframe, stereo, and cave mode on a facet
+// view. Example failure: a toggle that changes the Show's state but not what is drawn (the
+// renderer reading a copy), or one that does not come back on the second press.
+TEST_F(SceneDisplay, EachSetupToggleChangesThePicture) {
+  std::ofstream(folder_ / "wall.obj") << cubeObj("wall", 0, 0, -5, 1.5);
+  std::ofstream(folder_ / "s.sce") << "projection fov[60] nearclip[0.5] farclip[50]\neyespacing[0.5]\n"
+                                      "light position[0.5,0.5,-3,1] ambient[0,0,0] diffuse[255,255,255] "
+                                      "specular[0,0,0]\n"
+                                      "fog start[1] end[12] color[0,0,255] function[linear]\nimport wall.obj\n";
+  formats::LoadOptions options;
+  options.logWarnings = false;
+  auto loaded = formats::loadScene(folder_ / "s.sce", options);
+  ASSERT_TRUE(loaded) << loaded.error().describe();
+  runtime::Show show;
+  formats::applyScene(show, *loaded);
+  const auto plain = [&] {
+    EXPECT_TRUE(output().beginFrame());
+    renderer().drawShow(show, {0, 0, kRenderSize, kRenderSize});
+    Image image;
+    EXPECT_TRUE(output().readBack(image));
+    return image;
+  };
+  const auto differing = [](const Image& a, const Image& b) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i + 3 < a.pixels.size(); i += 4) {
+      n += (a.pixels[i] != b.pixels[i] || a.pixels[i + 1] != b.pixels[i + 1] || a.pixels[i + 2] != b.pixels[i + 2])
+               ? 1U
+               : 0U;
+    }
+    return n;
+  };
+  const Image start = plain();
+  runtime::SetupToggles toggles;
+  using T = runtime::SetupToggle;
+  for (const T t : {T::kFog, T::kLighting, T::kSmoothShading, T::kWireframe, T::kPoints, T::kStereo}) {
+    const std::string name(runtime::setupToggleName(t));
+    toggles.apply(t, show);
+    EXPECT_GT(differing(start, plain()), 500u) << name << " changed nothing drawn";
+    toggles.apply(t == T::kWireframe || t == T::kPoints ? T::kFilled : t, show);
+    EXPECT_EQ(differing(start, plain()), 0u) << name << " did not come back";
+  }
+
+  // Cave mode off: the facet view shows the plain view instead of its facet.
+  kiosk::ViewSpec spec;
+  spec.name = "front";
+  spec.kind = kiosk::ViewKind::kFacet;
+  spec.cave = folder_ / "display.cave";
+  auto views = kiosk::DisplayViews::create({spec}, renderer(), output().size());
+  ASSERT_TRUE(views) << views.error().describe();
+  const auto facet = [&] {
+    EXPECT_TRUE(output().beginFrame());
+    (*views)->drawViews(show, output().size(), {});
+    Image image;
+    EXPECT_TRUE(output().readBack(image));
+    return image;
+  };
+  const Image caveOn = facet();
+  (*views)->setCaveMode(false);
+  const Image caveOff = facet();
+  EXPECT_GT(differing(caveOn, caveOff), 500u);
+  EXPECT_EQ(differing(caveOff, start), 0u) << "cave mode off is the plain view";
 }
 
 }  // namespace
