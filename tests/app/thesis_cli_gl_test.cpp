@@ -15,12 +15,17 @@
 
 #include <gtest/gtest.h>
 
+#include <signal.h>
+
+#include <chrono>
 #include <fstream>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "media/image_io.h"
+#include "support/kiosk_process.h"
 #include "support/polyhedra.h"
 #include "support/process.h"
 #include "support/test_paths.h"
@@ -112,6 +117,57 @@ TEST(ThesisCommandLine, OneDisplayAndOneSceneOnly) {
   r = runBasalt({"run", (dir / "missing.sce").string(), "--frames", "1", "--headless"});
   EXPECT_EQ(r.exitCode, 1) << r.output;
   EXPECT_NE(r.output.find("no such file"), std::string::npos) << r.output;
+}
+
+// The set-up toggles for a kiosk without a keyboard: POST /control/setup with the toggle's name
+// and the control token, as the keys do. Example failures: the request refused as an unknown
+// path; a toggle that answers but changes nothing on screen; an unknown name taken as another.
+TEST(ThesisCommandLine, SetUpTogglesAsControlRequests) {
+  std::string why;
+  if (!test::headlessEglWorks(why)) GTEST_SKIP() << "no headless EGL here: " << why;
+  const auto dir = test::writeShow("thesis-setup-control", R"(
+[show]
+entry = "scene.sce"
+fps = 30
+
+[output]
+kind = "headless"
+size = "160x120"
+
+[status]
+listen = "127.0.0.1:0"
+token_file = "token"
+)");
+  const std::string token = "0123456789abcdef0123456789abcdef";
+  std::ofstream(dir / "token") << token << "\n";
+  std::ofstream(dir / "box.obj") << boxObj(-1, -1, -6, 1, 1, -4);
+  std::ofstream(dir / "scene.sce") << "projection fov[60]\nfog start[1] end[8] color[0,0,255] function[linear]\n"
+                                      "import box.obj\n";
+  auto show = test::RunningShow::start({(dir / "show.toml").string(), "--realtime", "--no-resume"}, {}, why);
+  ASSERT_TRUE(show) << why;
+  const std::string bearer = "Bearer " + token;
+  const auto before = show->get("/snapshot.png");
+  ASSERT_EQ(before.status, 200);
+  auto r = show->post("/control/setup", "fog", bearer);
+  EXPECT_EQ(r.status, 200) << r.body;
+  EXPECT_NE(r.body.find("fog off"), std::string::npos) << r.body;
+  r = show->post("/control/setup", "wireframe", bearer);
+  EXPECT_EQ(r.status, 200) << r.body;
+  EXPECT_NE(r.body.find("surfaces drawn as wireframe"), std::string::npos) << r.body;
+  // The status server keeps a snapshot for a second.
+  std::this_thread::sleep_for(std::chrono::milliseconds(1300));
+  const auto after = show->get("/snapshot.png");
+  ASSERT_EQ(after.status, 200);
+  EXPECT_NE(before.body, after.body) << "the toggles changed nothing on screen";
+  r = show->post("/control/setup", "cave", bearer);
+  EXPECT_EQ(r.status, 200) << r.body;
+  EXPECT_NE(r.body.find("no facet views"), std::string::npos) << r.body;
+  r = show->post("/control/setup", "fogg", bearer);
+  EXPECT_EQ(r.status, 400) << r.body;
+  r = show->post("/control/setup", "fog");
+  EXPECT_NE(r.status, 200) << "the control token is needed";
+  show->process().signal(SIGTERM);
+  EXPECT_EQ(show->process().wait().exitCode, 0);
 }
 
 }  // namespace

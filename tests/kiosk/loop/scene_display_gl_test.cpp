@@ -23,6 +23,7 @@
 #include <fstream>
 
 #include "kiosk/loop/display_views.h"
+#include "kiosk/manifest/manifest.h"
 #include "runtime/formats/scene.h"
 #include "runtime/setup_keys.h"
 #include "support/polyhedra.h"
@@ -229,6 +230,41 @@ TEST_F(SceneDisplay, EachSetupToggleChangesThePicture) {
   const Image caveOff = facet();
   EXPECT_GT(differing(caveOn, caveOff), 500u);
   EXPECT_EQ(differing(caveOff, start), 0u) << "cave mode off is the plain view";
+}
+
+// The manifest's keys: `view` beside an entry (scene or fit, only for scenes and models), and a
+// facet view's `display_scale` and `display_at`. Example failures: `view` accepted for a script
+// and silently meaningless; a display scale of 0 accepted (a display of no size).
+TEST(SceneDisplayManifest, ViewAndDisplayKeysAreReadAndChecked) {
+  const std::filesystem::path folder = scratchDir("scene_display_manifest");
+  std::ofstream(folder / "display.obj") << cubeDisplayObj();
+  std::ofstream(folder / "display.cave") << "model display.obj\n";
+  std::ofstream(folder / "s.sce") << "position[0,0,5]\n";
+  std::ofstream(folder / "m.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
+  std::ofstream(folder / "a.mdl") << "draw\n";
+  kiosk::Diagnostics diagnostics;
+  auto m = kiosk::readManifestText(
+      "[show]\nentry = \"s.sce\"\nview = \"fit\"\n[kiosk]\nplaylist = [{ entry = \"m.obj\", view = "
+      "\"scene\", duration = \"5s\" }, { entry = \"s.sce\", duration = \"5s\" }]\n"
+      "[[views]]\nname = \"front\"\nkind = \"facet\"\ncave = \"display.cave\"\ndisplay_scale = 2.5\n"
+      "display_at = [0, -1.6, 0.5]\n",
+      folder / "show.toml", diagnostics);
+  ASSERT_TRUE(m) << diagnostics.format();
+  EXPECT_EQ(m->entry.view, kiosk::EntryView::kFit);
+  ASSERT_EQ(m->kiosk.playlist.size(), 2u);
+  EXPECT_EQ(m->kiosk.playlist[0].entry.view, kiosk::EntryView::kScene);
+  EXPECT_EQ(m->kiosk.playlist[1].entry.view, kiosk::EntryView::kDefault);
+  ASSERT_EQ(m->views.size(), 1u);
+  EXPECT_FLOAT_EQ(m->views[0].displayScale, 2.5f);
+  EXPECT_EQ(m->views[0].displayAt, (std::array<float, 3>{0, -1.6f, 0.5f}));
+
+  for (const char* bad :
+       {"[show]\nentry = \"a.mdl\"\nview = \"scene\"\n", "[show]\nentry = \"s.sce\"\nview = \"both\"\n",
+        "[[views]]\nkind = \"facet\"\ncave = \"display.cave\"\ndisplay_scale = 0\n",
+        "[[views]]\nkind = \"facet\"\ncave = \"display.cave\"\ndisplay_at = [1, 2]\n"}) {
+    kiosk::Diagnostics d;
+    EXPECT_FALSE(kiosk::readManifestText(bad, folder / "show.toml", d)) << bad;
+  }
 }
 
 }  // namespace
