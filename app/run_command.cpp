@@ -136,6 +136,7 @@ Result<std::filesystem::path> showFolderManifest(const std::filesystem::path& fo
 
 std::string_view runUsage() {
   return R"(Usage: basalt run [options] [show.toml | SHOW_FOLDER | SCRIPT.mdl]
+       basalt run [options] [DISPLAY.cave] [SCENE.sce | MODEL.obj]
 
 Plays a show. With a show manifest (show.toml, see configs/shows/), or a show folder that
 holds one (SHOW_FOLDER/show.toml), it plays that show: its outputs, entry, devices and
@@ -147,6 +148,11 @@ running), a window when a display server is there, offscreen (headless) otherwis
 headless output writes a snapshot of the last frame.
 Without --frames or --seconds it runs until interrupted (Ctrl-C, SIGTERM) and exits cleanly.
 SIGHUP re-reads the manifest; the show plays on until the new one is ready.
+
+The thesis' command line (`3Deng [.cave] [.sce] [.obj]`) plays a scene or a model without a
+manifest: a scene is drawn from its own camera in its own units, a model as LAVA shows it;
+with a display file (.cave) the output shows the facet it names, seen through the display
+that the scene's camera places in the world (Appendix B's set-up keys adjust it).
 
 SHOW may be a LAVA script (.mdl), run as `lava -file SHOW.mdl` ran it: each `draw` is one
 frame, `quit` ends the run, and a bad line is reported and skipped while the show goes on.
@@ -267,9 +273,30 @@ Result<RunOptions> parseRunOptions(std::span<const std::string_view> args) {
   RunOptions run;
   for (const ParsedOption& o : *parsed) {
     if (o.name.empty()) {
-      if (run.manifest || run.show) {
+      const std::string ext = std::filesystem::path(o.value).extension().string();
+      if (ext == ".cave" || ext == ".sce" || ext == ".obj" || ext == ".off") {
+        // The thesis' command line: [display.cave] [scene.sce | model.obj].
+        std::optional<std::filesystem::path>& slot = ext == ".cave" ? run.cave : run.scene;
+        if (slot || run.manifest || run.show) {
+          return fail(Errc::kInvalidArgument,
+                      fmt::format("'basalt run' plays one display file (.cave) with one scene (.sce) or model "
+                                  "(.obj, .off); '{}' comes after '{}'",
+                                  o.value,
+                                  (slot           ? *slot
+                                   : run.manifest ? *run.manifest
+                                                  : *run.show)
+                                      .string()));
+        }
+        slot = std::filesystem::path(o.value);
+        continue;
+      }
+      if (run.manifest || run.show || run.cave || run.scene) {
         return fail(Errc::kInvalidArgument, fmt::format("'basalt run' plays one show; '{}' comes after '{}'", o.value,
-                                                        (run.manifest ? *run.manifest : *run.show).string()));
+                                                        (run.manifest ? *run.manifest
+                                                         : run.show   ? *run.show
+                                                         : run.cave   ? *run.cave
+                                                                      : *run.scene)
+                                                            .string()));
       }
       if (o.value.empty()) return fail(Errc::kInvalidArgument, "the show's file name is empty");
       if (std::error_code ec; std::filesystem::is_directory(o.value, ec)) {
@@ -469,6 +496,37 @@ std::optional<Manifest> readShowManifest(const std::filesystem::path& file, bool
   return manifest;
 }
 
+/// The show the thesis' command line asks for (Appendix B, `3Deng [.cave] [.sce] [.obj]`): the
+/// scene or model as the entry, drawn as its kind is by default (a scene from its own camera),
+/// and with a display file one facet view filling the output, on the facet the file names.
+Result<Manifest> thesisManifest(const RunOptions& options) {
+  Manifest m = Manifest::builtinDefault();
+  std::error_code ec;
+  if (options.scene) {
+    const std::filesystem::path scene = std::filesystem::absolute(*options.scene, ec).lexically_normal();
+    if (ec || !std::filesystem::is_regular_file(scene, ec)) {
+      return fail(Errc::kNotFound, fmt::format("{}: no such file", options.scene->string()));
+    }
+    m.folder = scene.parent_path();
+    m.name = scene.filename().string();
+    const bool isScene = scene.extension() == ".sce";
+    m.entry = {isScene ? EntryKind::kScene : EntryKind::kModel, options.scene->string(), scene, 0, EntryView::kDefault};
+  }
+  if (options.cave) {
+    const std::filesystem::path cave = std::filesystem::absolute(*options.cave, ec).lexically_normal();
+    if (ec || !std::filesystem::is_regular_file(cave, ec)) {
+      return fail(Errc::kNotFound, fmt::format("{}: no such file", options.cave->string()));
+    }
+    if (m.folder.empty()) m.folder = cave.parent_path();
+    ViewSpec view;
+    view.name = cave.stem().string();
+    view.kind = ViewKind::kFacet;
+    view.cave = cave;
+    m.views.push_back(std::move(view));
+  }
+  return m;
+}
+
 /// This node's addresses beside its name ("kiosk-3 (192.168.1.20, fe80::1)"), for the problem
 /// card: what a technician types to reach its status page.
 std::string nodeAddress() {
@@ -523,7 +581,7 @@ Fallback fallBack(const RunOptions& options, std::vector<std::string> errors, bo
   f.card = true;
   f.manifest = Manifest::builtinDefault();
   f.manifest.name = "problem card";
-  f.manifest.entry = {EntryKind::kBuiltinBlack, "black", {}, 0};
+  f.manifest.entry = {EntryKind::kBuiltinBlack, "black", {}, 0, EntryView::kDefault};
   f.manifest.file = original;  // a reload re-reads the show
   f.manifest.kiosk.resume = false;
   f.manifest.status.enabled = true;  // the technician's way in: the default 127.0.0.1:8180 unless --status
@@ -649,6 +707,11 @@ int runShow(const RunOptions& options) {
       fallback = fallBack(options, std::move(errors));
       manifest = fallback->manifest;
     }
+  }
+  if (options.cave || options.scene) {
+    auto thesis = thesisManifest(options);
+    if (!thesis) return failWith(thesis.error(), "cannot start");
+    manifest = std::move(*thesis);
   }
   if (stderrIsJournal()) logToJournal(manifest.name);
   if (options.camera) {

@@ -25,6 +25,10 @@ struct RunOptions {
   bool help = false;                              ///< --help was given
   std::optional<std::filesystem::path> manifest;  ///< the show.toml to play; none: the default show
   std::optional<std::filesystem::path> show;      ///< a LAVA script (.mdl) to play on the default show
+  /// The thesis' command line (Appendix B, `3Deng [.cave] [.sce] [.obj]`): a display file whose
+  /// facet fills the output, and a scene or a model to play, without a manifest.
+  std::optional<std::filesystem::path> cave;
+  std::optional<std::filesystem::path> scene;     ///< a `.sce` scene or a model (.obj, .off)
   std::optional<render::OutputKind> output;       ///< --output (or --headless); none: the manifest's
   bool sizeGiven = false;                         ///< --size was given (else the manifest's size)
   bool fpsGiven = false;                          ///< --fps was given (else the manifest's)

@@ -1039,33 +1039,90 @@ runtime::Color3 Renderer::clearColor(const Show& show) {
                                                                                           : show.global().background;
 }
 
+namespace {
+
+/// A scene's own viewport (thesis §4.3.4 and C.3, `viewport position[x,y] resolution[w,h]`:
+/// glViewport's rectangle, in pixels from the bottom left of the view it is drawn in). The view's
+/// clip space is squeezed into that rectangle and drawing is scissored to it; the view's clears
+/// still cover the whole view, as the thesis' glClear covers the whole window.
+struct SceneRectangle {
+  bool used = false;
+  float aspect = 1;  ///< the rectangle's
+  Mat4 place;        ///< clip space of the rectangle to clip space of the view
+  Viewport scissor;  ///< the rectangle within the view, in window pixels
+};
+
+SceneRectangle sceneRectangle(const Show& show, const Viewport& view) {
+  SceneRectangle r;
+  const runtime::Viewer& c = show.viewer();
+  if (c.framing != runtime::Framing::kScene || c.viewportWidth <= 0 || c.viewportHeight <= 0) return r;
+  const auto vw = static_cast<float>(std::max(view.width, 1U)), vh = static_cast<float>(std::max(view.height, 1U));
+  const auto x = static_cast<float>(c.viewportX), y = static_cast<float>(c.viewportY);
+  const auto w = static_cast<float>(c.viewportWidth), h = static_cast<float>(c.viewportHeight);
+  r.used = true;
+  r.aspect = w / h;
+  r.place = Mat4::translation({(2 * x + w) / vw - 1, (2 * y + h) / vh - 1, 0}) * Mat4::scaling({w / vw, h / vh, 1});
+  const std::int64_t x0 = std::clamp<std::int64_t>(c.viewportX, 0, view.width);
+  const std::int64_t y0 = std::clamp<std::int64_t>(c.viewportY, 0, view.height);
+  const std::int64_t x1 = std::clamp<std::int64_t>(std::int64_t{c.viewportX} + c.viewportWidth, 0, view.width);
+  const std::int64_t y1 = std::clamp<std::int64_t>(std::int64_t{c.viewportY} + c.viewportHeight, 0, view.height);
+  if (x1 <= x0 || y1 <= y0) {
+    // Off the view: a scissor beside it draws nothing (an empty one would mean the whole view).
+    r.scissor = {view.x - 2, view.y - 2, 1, 1};
+  } else {
+    r.scissor = {view.x + static_cast<std::int32_t>(x0), view.y + static_cast<std::int32_t>(y0),
+                 static_cast<std::uint32_t>(x1 - x0), static_cast<std::uint32_t>(y1 - y0)};
+  }
+  return r;
+}
+
+}  // namespace
+
 void Renderer::drawShow(const Show& show, const Viewport& viewport,
                         const std::function<void(runtime::ViewTransforms&)>& adjust) {
+  const SceneRectangle rect = sceneRectangle(show, viewport);
   const float aspect =
-      static_cast<float>(std::max(viewport.width, 1U)) / static_cast<float>(std::max(viewport.height, 1U));
-  auto adjusted = [&adjust](runtime::ViewTransforms view) {
+      rect.used ? rect.aspect
+                : static_cast<float>(std::max(viewport.width, 1U)) / static_cast<float>(std::max(viewport.height, 1U));
+  auto adjusted = [&adjust, &rect](runtime::ViewTransforms view) {
     if (adjust) adjust(view);
+    if (rect.used) view.projection = rect.place * view.projection;
     return view;
   };
   if (show.global().stereo) {
     const float half = 0.5f * runtime::eyeSpacingInWindowUnits(show);
     const runtime::ViewTransforms left = adjusted(runtime::computeEyeView(show, aspect, -half));
     const runtime::ViewTransforms right = adjusted(runtime::computeEyeView(show, aspect, half));
-    if (show.stereo().mode == runtime::StereoMode::kAnaglyph) {
+    if (show.stereo().mode == runtime::StereoMode::kAnaglyph && !rect.used) {
       drawAnaglyph(show, left, right, viewport);
+      return;
+    }
+    if (show.stereo().mode == runtime::StereoMode::kAnaglyph) {
+      ViewPass leftEye;
+      leftEye.viewport = viewport;
+      leftEye.scissor = rect.scissor;
+      leftEye.colorMask = {true, false, false};
+      draw(show, left, leftEye);
+      ViewPass rightEye = leftEye;
+      rightEye.drawBackground = false;
+      rightEye.colorMask = {false, true, true};
+      draw(show, right, rightEye);
       return;
     }
     // Passive stereo: each eye squeezed into its half at the whole viewport's aspect ratio.
     const std::array<Viewport, 2> eyes = stereoViewports(viewport, show.stereo().mode);
     ViewPass pass;
     pass.viewport = eyes[0];
+    pass.scissor = rect.used ? sceneRectangle(show, eyes[0]).scissor : Viewport{};
     draw(show, left, pass);
     pass.viewport = eyes[1];
+    pass.scissor = rect.used ? sceneRectangle(show, eyes[1]).scissor : Viewport{};
     draw(show, right, pass);
     return;
   }
   ViewPass pass;
   pass.viewport = viewport;
+  pass.scissor = rect.scissor;
   draw(show, adjusted(runtime::computeView(show, aspect)), pass);
 }
 

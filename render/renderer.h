@@ -90,7 +90,9 @@ class Renderer {
   void draw(const runtime::Show& show, const runtime::ViewTransforms& view, Size viewport);
   /// \brief Draws one view as `pass` says.
   void draw(const runtime::Show& show, const runtime::ViewTransforms& view, const ViewPass& pass);
-  /// \brief The show as its settings ask: LAVA's view fitted to the viewport, in anaglyph
+  /// \brief The show as its settings ask: LAVA's view fitted to the viewport or a scene seen
+  /// from its own camera (runtime::computeView), in the scene's own viewport rectangle within
+  /// `viewport` when it gives one (the rest of the viewport is cleared to the background), in
   /// stereo when `global().stereo` is on. What the frame loop calls. `adjust`, when given, may
   /// change each computed view before it is drawn (a script's sub-pixel jitter).
   void drawShow(const runtime::Show& show, const Viewport& viewport,

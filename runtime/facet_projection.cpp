@@ -98,12 +98,12 @@ Result<void> computeFacetView(const formats::CaveFacet& facet, const FacetViewIn
 
 Mat4 cavePlacement(const Show& show) {
   const Viewer& v = show.viewer();
-  if (v.fromScene) {
-    return Mat4::translation(v.position) * Mat4::rotationX(v.rotation.x) * Mat4::rotationY(v.rotation.y) *
-           Mat4::rotationZ(v.rotation.z);
-  }
+  if (v.framing == Framing::kScene) return cameraTransform(v.position, v.rotation);
+  // LAVA's eye, moved by the walking viewer in window units (as computeView moves it).
   const float d = show.view().perspective > 0 ? show.view().perspective : 4.0f;
-  return Mat4::translation({0, 0, d});
+  const float scale = sceneScale(show);
+  return Mat4::translation({0, 0, d}) *
+         cameraTransform(v.position * (scale > 0 && std::isfinite(scale) ? scale : 1.0f), v.rotation);
 }
 
 Vec3 projectCavePoint(const FacetProjection& projection, const Mat4& worldFromCave, const Vec3& cavePoint) {

@@ -64,10 +64,11 @@ struct FacetProjection {
                                             FacetProjection& out);
 
 /// \brief Where the show puts the display geometry (thesis §4.4.4: the camera places the
-/// display, the viewer moves inside it). A scene's viewer (`Show::viewer()`, when a scene set
-/// it) places the geometry's origin at its position, turned by its rotation (X, then Y, then
-/// Z); otherwise the origin sits at LAVA's eye, `view().perspective` units out on +Z, unturned,
-/// so that the facet facing -Z shows what the plain view shows.
+/// display, the viewer moves inside it). A scene drawn from its own camera (Framing::kScene)
+/// places the geometry's origin at the camera, turned as the camera is (cameraTransform), in
+/// scene units; otherwise the origin sits at LAVA's eye, `view().perspective` units out on +Z,
+/// moved as the walking viewer moves the plain view's eye, so that the facet facing -Z shows
+/// what the plain view shows.
 Mat4 cavePlacement(const Show& show);
 
 /// \brief Where a cave point lands on the facet's image, in normalised device coordinates

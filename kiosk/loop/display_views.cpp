@@ -130,8 +130,12 @@ runtime::FacetViewInput DisplayViews::facetInput(const View& v, const runtime::S
   runtime::FacetViewInput input;
   input.viewer = show.head().tracked ? show.head().position : viewer_;
   input.calibration = v.cave.settings;
-  input.worldFromCave = runtime::cavePlacement(show);
-  input.farDistance = show.viewer().farClip;
+  // The camera places the display (thesis §4.4.4); the manifest says where it stands from the
+  // camera and how many scene units one of its units is.
+  input.worldFromCave = runtime::cavePlacement(show) *
+                        Mat4::translation({v.spec.displayAt[0], v.spec.displayAt[1], v.spec.displayAt[2]}) *
+                        Mat4::scaling({v.spec.displayScale, v.spec.displayScale, v.spec.displayScale});
+  input.farDistance = show.viewer().farClip / v.spec.displayScale;  // the facet's eye space is in cave units
   input.rearProjection = v.spec.rearProjection;
   return input;
 }
@@ -187,6 +191,10 @@ void DisplayViews::drawViews(const runtime::Show& show, render::Size output,
         break;
       }
       case ViewKind::kFacet: {
+        if (!caveMode_) {
+          renderer_.drawShow(show, vp, adjust);
+          break;
+        }
         const formats::CaveGeometry& g = *v.cave.geometry;
         const std::uint32_t index = v.cave.settings.facet < g.facets.size() ? v.cave.settings.facet : 0;
         render::FacetPass pass;

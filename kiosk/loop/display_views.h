@@ -66,6 +66,11 @@ class DisplayViews final : public ViewDrawer {
   /// \brief A keyboard event for the calibration keys; they act on the current facet view
   /// (the first, or the one chosen with selectView). True when something changed.
   bool applyKey(const Event& event);
+  /// \brief The thesis' cave mode (Appendix B `c`): on (the default), facet views show their
+  /// facets; off, each shows the plain view of the show in its viewport instead.
+  void setCaveMode(bool on) { caveMode_ = on; }
+  [[nodiscard]] bool caveMode() const { return caveMode_; }
+  [[nodiscard]] bool hasFacetViews() const { return facetViewNamed({}).has_value(); }
   /// \brief The view the calibration keys act on; false when `index` is not a facet view.
   bool selectView(std::size_t index);
   /// \brief The calibration of view `index` (a facet view), to read or change live.
@@ -128,6 +133,7 @@ class DisplayViews final : public ViewDrawer {
   std::vector<View> views_;
   Vec3 viewer_;  ///< the fixed viewer (display units)
   std::size_t current_ = 0;
+  bool caveMode_ = true;
   runtime::CaveKeys keys_;
   std::vector<std::string> problems_;
   std::uint64_t problemsVersion_ = 0;

@@ -168,7 +168,7 @@ bool LockSpec::loopbackOnly() const { return loopbackHost(role == LockRole::kFol
 Manifest Manifest::builtinDefault() {
   Manifest m;
   m.name = "default show";
-  m.entry = {EntryKind::kBuiltinDefault, "default", {}, 0};
+  m.entry = {EntryKind::kBuiltinDefault, "default", {}, 0, EntryView::kDefault};
   return m;
 }
 
@@ -712,7 +712,7 @@ class Reader {
     manifest_.folder = std::filesystem::weakly_canonical(folder_, ec);
     if (ec) manifest_.folder = folder_;
     manifest_.name = manifest_.folder.filename().string();
-    manifest_.entry = {EntryKind::kBuiltinDefault, "default", {}, 0};
+    manifest_.entry = {EntryKind::kBuiltinDefault, "default", {}, 0, EntryView::kDefault};
 
     checkKeys(root, "",
               {"show", "output", "views", "viewer", "media", "devices", "bindings", "textures", "kiosk", "status",
@@ -1002,9 +1002,23 @@ class Reader {
     return e;
   }
 
+  /// `view = "scene" | "fit"` beside an entry: how its world is framed.
+  void entryView(const toml::table& t, const std::string& path, EntrySpec& e) {
+    const auto view = choice<EntryView>(t, "view", path, {{"scene", EntryView::kScene}, {"fit", EntryView::kFit}});
+    if (!view) return;
+    if (e.kind != EntryKind::kScene && e.kind != EntryKind::kModel) {
+      error(lineOf(*t.get("view")),
+            fmt::format("{}.view: only a scene (.sce) or a model (.obj, .off) can be framed; {} is drawn as "
+                        "LAVA draws it",
+                        path, e.text));
+      return;
+    }
+    e.view = *view;
+  }
+
   // ---- [show] ----
   void readShow(const toml::table& t) {
-    checkKeys(t, "show", {"name", "entry", "fps"});
+    checkKeys(t, "show", {"name", "entry", "fps", "view"});
     if (auto name = string(t, "name", "show")) {
       if (name->empty()) {
         error(lineOf(*t.get("name")), "show.name: must not be empty");
@@ -1014,7 +1028,10 @@ class Reader {
     }
     if (auto fps = number(t, "fps", "show", 1, 1000)) manifest_.fps = *fps;
     if (const toml::node* n = t.get("entry")) {
-      if (auto e = entry(*n, "show.entry")) manifest_.entry = *e;
+      if (auto e = entry(*n, "show.entry")) {
+        manifest_.entry = *e;
+        entryView(t, "show", manifest_.entry);
+      }
     } else {
       note(lineOf(t), "show.entry: not given; the show plays the built-in default show");
     }
@@ -1089,7 +1106,7 @@ class Reader {
       v.line = lineOf(*t);
       checkKeys(*t, path,
                 {"name", "kind", "cave", "facet", "eye", "viewport", "stereo", "eye_spacing", "projection", "winding",
-                 "of", "from"});
+                 "of", "from", "display_at", "display_scale"});
       v.name = string(*t, "name", path).value_or(fmt::format("view {}", index));
       if (!names.insert(v.name).second)
         error(v.line, fmt::format("{}: a view named '{}' already exists", path, v.name));
@@ -1147,6 +1164,12 @@ class Reader {
       }
       if (auto of = string(*t, "of", path)) v.of = *of;
       if (const toml::node* from = t->get("from")) readFrom(*from, path, v);
+      if (const toml::node* at = t->get("display_at")) readDisplayAt(*at, path, v);
+      if (auto scale = number(*t, "display_scale", path, 1e-6, 1e6)) v.displayScale = static_cast<float>(*scale);
+      if (v.kind != ViewKind::kFacet && v.kind != ViewKind::kAids &&
+          (t->get("display_at") || t->get("display_scale"))) {
+        warning(v.line, fmt::format("{}: display_at and display_scale apply to facet and aids views only", path));
+      }
       if (v.kind != ViewKind::kAids && (t->get("of") || t->get("from"))) {
         warning(v.line, fmt::format("{}: of and from apply to aids views only", path));
       }
@@ -1264,6 +1287,23 @@ class Reader {
       return;
     }
     v.from = values;
+  }
+
+  void readDisplayAt(const toml::node& node, const std::string& path, ViewSpec& v) {
+    const toml::array* a = node.as_array();
+    std::array<float, 3> values{};
+    bool ok = a && a->size() == 3;
+    for (std::size_t i = 0; ok && i < 3; ++i) {
+      const toml::node* element = a->get(i);
+      const auto n = element ? element->value<double>() : std::nullopt;
+      ok = n && std::isfinite(*n) && std::abs(*n) <= 1e6;
+      if (ok) values[i] = static_cast<float>(*n);
+    }
+    if (!ok) {
+      error(lineOf(node), fmt::format("{}.display_at: must be a position [x, y, z] in scene units", path));
+      return;
+    }
+    v.displayAt = values;
   }
 
   void readViewport(const toml::node& node, const std::string& path, ViewSpec& v) {
@@ -1976,7 +2016,7 @@ class Reader {
         error(lineOf(n), fmt::format("{}: must be {{ entry = \"...\", duration = \"5m\" }}", ip));
         continue;
       }
-      checkKeys(*t, ip, {"entry", "duration", "name"});
+      checkKeys(*t, ip, {"entry", "duration", "name", "view"});
       PlaylistItem item;
       item.line = lineOf(*t);
       const toml::node* e = t->get("entry");
@@ -1987,6 +2027,7 @@ class Reader {
       auto spec = entry(*e, ip + ".entry");
       if (!spec) continue;
       item.entry = *spec;
+      entryView(*t, ip, item.entry);
       item.name = string(*t, "name", ip).value_or(spec->path.empty() ? spec->text : spec->path.filename().string());
       if (auto d = duration(*t, "duration", ip)) item.duration = *d;
       if (t->get("duration") && item.duration < std::chrono::seconds(1)) {

@@ -113,6 +113,10 @@ struct ViewSpec {
   formats::FacetWinding winding = formats::FacetWinding::kInward;
   std::string of;                            ///< aids: the facet view whose set-up is shown ("" = the first facet view)
   std::optional<std::array<float, 3>> from;  ///< aids: direction the display is seen from (cave axes)
+  /// facet and aids: where the display geometry's origin stands, relative to the camera in the
+  /// camera's axes (`display_at = [x, y, z]`, scene units; the thesis puts it at the camera)
+  std::array<float, 3> displayAt{0, 0, 0};
+  float displayScale = 1.0f;  ///< facet and aids: scene units per cave unit (`display_scale`)
 };
 
 /// \brief `[viewer]`: where an immersive display's viewer is (thesis §4.4.3: every facet's
@@ -141,11 +145,19 @@ enum class EntryKind : std::uint8_t {
 };
 std::string_view entryKindName(EntryKind kind);
 
+/// \brief How an entry's world is framed (`view = "scene" | "fit"` beside the entry).
+enum class EntryView : std::uint8_t {
+  kDefault,  ///< the entry's own: a scene's camera for `.sce`, LAVA's fit for everything else
+  kScene,    ///< drawn in its own units from the scene's camera (a model: the thesis' default camera)
+  kFit,      ///< LAVA's view: fitted to the window
+};
+
 struct EntrySpec {
   EntryKind kind = EntryKind::kBuiltinDefault;
   std::string text;            ///< as written in the manifest
   std::filesystem::path path;  ///< resolved, inside the show folder; empty for built-ins
   int line = 0;
+  EntryView view = EntryView::kDefault;  ///< scenes and models
   friend bool operator==(const EntrySpec&, const EntrySpec&) = default;
 };
 

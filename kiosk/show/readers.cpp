@@ -95,6 +95,8 @@ Result<std::unique_ptr<ItemPlayer>> makeModelItem(const EntrySpec& entry, const 
   if (!model) return std::unexpected(model.error().at(entryWhere(entry, manifest)));
   runtime::Show show = script::startupShow();
   if (auto r = formats::replaceObject(show, *model); !r) return std::unexpected(r.error());
+  // `view = "scene"`: the model in its own units, seen from the thesis' default camera (F.1).
+  if (entry.view == EntryView::kScene) show.viewer().framing = runtime::Framing::kScene;
   useManifestTextures(show, manifest);
   PreparedImages images;
   readOwnTextures(show, manifest, entry.path.string(), images);
@@ -120,6 +122,7 @@ Result<std::unique_ptr<ItemPlayer>> makeSceneItem(const EntrySpec& entry, const 
   runtime::Show show = script::startupShow();
   std::vector<formats::Diagnostic> warnings;
   formats::applyScene(show, *scene, &warnings);
+  if (entry.view == EntryView::kFit) formats::useFitFraming(show);
   for (const formats::Diagnostic& w : warnings) log::warn(kLogItems, "{}", w.describe());
   useManifestTextures(show, manifest);
   PreparedImages images;

@@ -400,6 +400,17 @@ void ShowDirector::handleControls(const FrameContext& frame) {
         }
         break;
       }
+      case ControlKind::kSetup: {
+        const auto toggle = runtime::parseSetupToggle(request.argument);
+        if (!toggle) {
+          reply.answer(400, fmt::format("'{}' is not a set-up toggle; use cave, stereo, fog, smooth, lighting, "
+                                        "filled, points, wireframe, normals, light-tokens, pause, control or exit",
+                                        request.argument));
+          break;
+        }
+        reply.answer(200, applySetup(*toggle));
+        break;
+      }
       case ControlKind::kCalibrate: {
         if (!views_) {
           reply.answer(409, "this show has no facet views to calibrate (add [[views]] with kind = \"facet\")");
@@ -557,7 +568,11 @@ void ShowDirector::applyOutputInput(Nanos now) {
       if ((e.kind == EventKind::kPointerMotion || e.value > 0.5) && !follower_ && policy_->noteInput(now)) {
         applyProgramme(now);
       }
-      if (e.kind == EventKind::kKey && views_ && views_->applyKey(e)) continue;
+      if (const auto toggle = setup_.key(e)) {
+        applySetup(*toggle);
+        continue;
+      }
+      if (e.kind == EventKind::kKey && setup_.controlMode() && views_ && views_->applyKey(e)) continue;
       if (e.kind == EventKind::kPointerButton) {
         pointerHeld_ = e.value > 0.5;
         continue;
@@ -583,6 +598,27 @@ void ShowDirector::applyOutputInput(Nanos now) {
     navigator_.advance(std::chrono::duration<double>(now - lastNavigate_).count(), context_.show);
   }
   lastNavigate_ = now;
+}
+
+std::string ShowDirector::applySetup(runtime::SetupToggle toggle) {
+  using runtime::SetupToggle;
+  std::string what;
+  if (toggle == SetupToggle::kCaveMode) {
+    if (views_ && views_->hasFacetViews()) {
+      views_->setCaveMode(!views_->caveMode());
+      what = views_->caveMode() ? "cave mode on: facet views show their facets"
+                                : "cave mode off: facet views show the plain view";
+    } else {
+      what = "cave mode: this show has no facet views";
+    }
+  } else if (toggle == SetupToggle::kExit) {
+    exitRequested_ = true;
+    what = "exit: the run ends after this frame";
+  } else {
+    what = setup_.apply(toggle, context_.show);
+  }
+  log::info(kLogDirector, "set-up: {}", what);
+  return what;
 }
 
 void ShowDirector::advanceShuttles(Nanos now) {

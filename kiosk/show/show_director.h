@@ -35,6 +35,7 @@
 #include "runtime/event.h"
 #include "runtime/event_loop.h"
 #include "runtime/navigation.h"
+#include "runtime/setup_keys.h"
 #include "runtime/show/show.h"
 
 namespace basalt::kiosk {
@@ -110,7 +111,11 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   Result<void> beforeDraw(const FrameContext& frame) override;
   Result<void> afterDraw(const FrameContext& frame, render::Output& output) override;
   void afterPresent(const FrameContext& frame) override;
-  [[nodiscard]] bool wantsStop() const override { return context_.output.closeRequested(); }
+  [[nodiscard]] bool wantsStop() const override { return context_.output.closeRequested() || exitRequested_; }
+  /// \brief Applies one of the thesis' set-up toggles (Appendix B) to the playing show and the
+  /// views, from a key or a control request; returns what it did (logged).
+  std::string applySetup(runtime::SetupToggle toggle);
+  [[nodiscard]] const runtime::SetupToggles& setupToggles() const { return setup_; }
 
   [[nodiscard]] const KioskPolicy* policy() const { return policy_.get(); }
   [[nodiscard]] const LoadedShow* loaded() const { return show_.get(); }
@@ -148,8 +153,9 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   void applyInput(Nanos until);
   void applyEvent(const Event& e, Nanos now);
   [[nodiscard]] DeviceSlot* slotFor(DeviceId id);
-  /// Keys and pointer from the output's window and from evdev keyboards and mice: activity for the kiosk, the facet
-  /// views' calibration keys (thesis Appendix B), then walking the viewer (Navigator): held keys move it per frame,
+  /// Keys and pointer from the output's window and from evdev keyboards and mice: activity for the kiosk, the set-up
+  /// toggles and (in control mode) the facet views' calibration keys (thesis Appendix B), then walking the viewer
+  /// (Navigator): held keys move it per frame,
   /// dragging with a button held turns it.
   void applyOutputInput(Nanos now);
   void advanceShuttles(Nanos now);
@@ -198,7 +204,10 @@ class ShowDirector final : public FrameParticipant, public LockedDirector {
   std::set<std::string> reportedFailures_;
   Nanos lastSave_{0};
   Nanos lastAdvance_{-1};  // the show time shuttle rings last turned the show to
-  // Keyboard and pointer of the output's window: calibration keys first, then navigation.
+  // Keyboard and pointer of the output's window: set-up toggles first, then (in control mode)
+  // calibration keys, then navigation.
+  runtime::SetupToggles setup_;
+  bool exitRequested_ = false;  // Esc or the exit toggle: the run ends after this frame
   runtime::Navigator navigator_;
   Nanos lastNavigate_{-1};    // the show time the navigator last moved the viewer to
   bool pointerHeld_ = false;  // a pointer button is down: motion turns the viewer

@@ -169,7 +169,8 @@ struct StatusSnapshot {
 
 /// \brief A request from the control server to the frame loop, answered through `reply`.
 /// kAction moves the show as a dial would (`action` by `amount`, runtime::applyAction), kResetView
-/// puts its transforms back; both come from OSC (kiosk/osc).
+/// puts its transforms back; both come from OSC (kiosk/osc). kSetup: one of the thesis' set-up
+/// toggles (Appendix B) by name, for kiosks without a keyboard.
 enum class ControlKind : std::uint8_t {
   kNext,
   kPrevious,
@@ -178,7 +179,8 @@ enum class ControlKind : std::uint8_t {
   kRestartDevice,
   kCalibrate,
   kAction,
-  kResetView
+  kResetView,
+  kSetup
 };
 
 struct ControlReply {
@@ -195,7 +197,7 @@ struct ControlReply {
 
 struct ControlRequest {
   ControlKind kind = ControlKind::kNext;
-  std::string argument;                             ///< the command, the device's name, or calibration statements
+  std::string argument;                             ///< the command, the device's name, calibration statements or a set-up toggle
   std::string view;                                 ///< kCalibrate: the facet view ("" = the first)
   bool save = false;                                ///< kCalibrate: write the calibration back to the cave file
   runtime::Action action = runtime::Action::kNone;  ///< kAction

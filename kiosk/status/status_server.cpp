@@ -570,7 +570,10 @@ void StatusServer::routes() {
       if (needsArgument && request.argument.empty()) {
         replyJson(res, 400, false,
                   kind == ControlKind::kRunCommand ? "the body must be one LAVA script command"
-                                                   : "name the device: ?device=NAME or the body");
+                  : kind == ControlKind::kSetup
+                      ? "name the set-up toggle in the body: cave, stereo, fog, smooth, lighting, filled, points, "
+                        "wireframe, normals, light-tokens, pause, control or exit"
+                      : "name the device: ?device=NAME or the body");
         return;
       }
       if (request.argument.find('\n') != std::string::npos || request.argument.find('\0') != std::string::npos) {
@@ -599,6 +602,7 @@ void StatusServer::routes() {
   http.Post("/control/command", control(ControlKind::kRunCommand, true));
   http.Post("/control/restart-device", control(ControlKind::kRestartDevice, true));
   http.Post("/control/calibrate", control(ControlKind::kCalibrate, false));
+  http.Post("/control/setup", control(ControlKind::kSetup, true));
 
   // Wrong methods on known paths say which method they take; unknown paths are 404 whatever the
   // method. Requests that may carry a body are answered at once when they announce none.
@@ -621,7 +625,7 @@ void StatusServer::routes() {
     http.Delete(path, withBody("GET"));
   }
   for (const char* path : {"/control/next", "/control/previous", "/control/reload", "/control/command",
-                           "/control/restart-device", "/control/calibrate"}) {
+                           "/control/restart-device", "/control/calibrate", "/control/setup"}) {
     http.Get(path, methodNotAllowed("POST"));
     http.Put(path, withBody("POST"));
     http.Patch(path, withBody("POST"));

@@ -47,6 +47,7 @@ class SceneParser {
       if (items_.empty()) continue;
       statement();
     }
+    wholeFileChecks();
     scene_.finalMaterial = material_;
     for (Diagnostic& w : d_.finish()) warnings.push_back(std::move(w));
     return std::move(scene_);
@@ -146,8 +147,14 @@ class SceneParser {
     const StatementItem& key = items_[0];
     const std::string k = lowerAscii(key.name);
     const auto v = values(0);
-    if (k == "viewport") return viewport();
-    if (k == "projection") return projection();
+    if (k == "viewport") {
+      viewportLine_ = lineNumber_;
+      return viewport();
+    }
+    if (k == "projection") {
+      projectionLine_ = lineNumber_;
+      return projection();
+    }
     if (k == "fog") return fog();
     if (k == "light") return light();
     if (k == "import" || k == "importdir" || k == "terrain") return source(k);
@@ -164,11 +171,11 @@ class SceneParser {
       }
       (k == "background" ? scene_.backgroundImage : scene_.skybox) = std::string(p);
     } else if (k == "mapmin") {
-      vec3(key, v, scene_.mapMin);
+      if (vec3(key, v, scene_.mapMin)) mapMinLine_ = lineNumber_;
     } else if (k == "mapmax") {
-      vec3(key, v, scene_.mapMax);
+      if (vec3(key, v, scene_.mapMax)) mapMaxLine_ = lineNumber_;
     } else if (k == "position") {
-      vec3(key, v, scene_.position);
+      if (vec3(key, v, scene_.position)) positionLine_ = lineNumber_;
     } else if (k == "rotation") {
       vec3(key, v, scene_.rotation);
     } else if (k == "positionchange") {
@@ -352,8 +359,36 @@ class SceneParser {
     scene_.sources.push_back(std::move(s));
   }
 
+  /// What only the whole file shows: values that parse but that the camera cannot honour as
+  /// written (thesis §4.3.1 and §4.3.4), each named at its line.
+  void wholeFileChecks() {
+    if (scene_.viewport && ((*scene_.viewport)[2] == 0 || (*scene_.viewport)[3] == 0)) {
+      d_.warn(viewportLine_, 1,
+              "the viewport has no area (give resolution[width,height] in pixels); the scene fills its view instead");
+    }
+    const Vec3 &lo = scene_.mapMin, &hi = scene_.mapMax;
+    if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) {
+      d_.warn(std::max(mapMinLine_, mapMaxLine_), 1,
+              "mapmin is beyond mapmax on some axis; the viewer is held at mapmax there when it moves");
+    } else {
+      const Vec3& p = scene_.position;
+      if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) {
+        d_.warn(positionLine_ ? positionLine_ : std::max(mapMinLine_, mapMaxLine_), 1,
+                "the viewer's start position is outside mapmin..mapmax; its first move puts it back inside");
+      }
+    }
+    // A 24-bit depth buffer resolves about one part in 2^24 of 1/near - 1/far.
+    if (scene_.farClip / scene_.nearClip > 1e6f) {
+      d_.warn(projectionLine_, 1,
+              fmt::format("farclip is {:g} times nearclip: the depth buffer cannot keep surfaces apart at that "
+                          "range (they flicker through each other); raise nearclip",
+                          scene_.farClip / scene_.nearClip));
+    }
+  }
+
   Diagnostics d_;
   const Limits& limits_;
+  std::uint32_t viewportLine_ = 0, projectionLine_ = 0, positionLine_ = 0, mapMinLine_ = 0, mapMaxLine_ = 0;
   SceneDescription scene_;
   SceneMaterial material_;
   std::string_view line_;
@@ -657,6 +692,7 @@ void applyScene(runtime::Show& show, const LoadedScene& scene, std::vector<Diagn
   show.stereo().units = runtime::Units::kScene;
   runtime::Viewer& v = show.viewer();
   v.fromScene = true;
+  v.framing = runtime::Framing::kScene;
   v.position = d.position;
   v.rotation = d.rotation;
   v.fieldOfView = d.fieldOfView;
@@ -674,6 +710,13 @@ void applyScene(runtime::Show& show, const LoadedScene& scene, std::vector<Diagn
     v.viewportHeight = (*d.viewport)[3];
   }
   v.followTerrain = !scene.terrains.empty();
+}
+
+void useFitFraming(runtime::Show& show) {
+  runtime::Viewer& v = show.viewer();
+  v.framing = runtime::Framing::kFit;
+  v.position = {0, 0, 0};
+  v.rotation = {0, 0, 0};
 }
 
 // ---- Writing -------------------------------------------------------------------------------------

@@ -152,9 +152,15 @@ struct LoadedScene {
 /// resolved by object name, adds the terrains, sets the lights (the scene's replace LAVA's
 /// defaults: light 0 is the global ambient kSceneGlobalAmbient, the scene's lights follow with
 /// their own ambient, diffuse and specular colours), background colour, image or skybox, fog,
-/// the stereo eye spacing and the viewer. Lights, fog and eye spacing are in the scene's units
-/// (`runtime::Units::kScene`). Problems are appended to `warnings`.
+/// the stereo eye spacing and the viewer, which draws the scene from its own camera in its own
+/// units (`runtime::Framing::kScene`; useFitFraming turns that back to LAVA's view). Lights, fog
+/// and eye spacing are in the scene's units (`runtime::Units::kScene`). Problems are appended
+/// to `warnings`.
 void applyScene(runtime::Show& show, const LoadedScene& scene, std::vector<Diagnostic>* warnings = nullptr);
+
+/// \brief Frames a show as LAVA does (a manifest's `view = "fit"`): the world fitted to the
+/// window from LAVA's eye, the viewer back at that eye (position and rotation 0) for walking.
+void useFitFraming(runtime::Show& show);
 
 /// \brief What a Show holds, as a scene description: background, fog, lights and viewer from the
 /// Show; one `import` per model file its nodes came from (built-in geometry is not written).

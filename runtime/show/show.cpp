@@ -225,6 +225,8 @@ void Show::advanceFrame() {
 }
 
 Mat4 viewNormalisation(const Show& show) {
+  // A scene drawn from its own camera keeps its own units.
+  if (show.viewer().framing == Framing::kScene) return {};
   const ViewSettings& v = show.view();
   const Bounds b = show.sceneBounds();
 
@@ -270,10 +272,51 @@ float eyeSpacingInWindowUnits(const Show& show) {
 
 ViewTransforms computeView(const Show& show, float aspect) { return computeEyeView(show, aspect, 0.0f); }
 
+namespace {
+
+/// The thesis' camera (§4.3.1): the world in its own units seen from the viewer, a symmetric
+/// frustum of `fieldOfView` degrees (vertical, as gluPerspective takes it) between the near and
+/// far clipping distances. A stereo eye moves `eyeOffset` along the camera's X axis and keeps
+/// the plane through the scene's centre where the mono view shows it.
+ViewTransforms sceneCameraView(const Show& show, float aspect, float eyeOffset) {
+  const Viewer& c = show.viewer();
+  ViewTransforms t;
+  t.model = show.position().global * show.position().local;
+  const Mat4 camera = cameraTransform(c.position, c.rotation);
+  const Mat4 eye = camera * Mat4::translation({eyeOffset, 0, 0});
+  t.eye = eye.transformPoint({0, 0, 0});
+  t.view = eye.inverted();
+  const float n = c.nearClip > 0 ? c.nearClip : 0.1f;
+  const float f = c.farClip > n ? c.farClip : n * 1000.0f;
+  const float fov = std::clamp(c.fieldOfView, 0.01f, 179.0f);
+  const float halfH = n * std::tan(radians(fov) * 0.5f);
+  const float halfW = halfH * (aspect > 0 ? aspect : 1.0f);
+  float shift = 0;
+  if (eyeOffset != 0) {
+    // Zero parallax at the scene's centre, measured along the line of sight.
+    const Bounds b = show.sceneBounds();
+    const Vec3 centre = b.empty ? Vec3{} : t.model.transformPoint(b.center());
+    float focus = -camera.inverted().transformPoint(centre).z;
+    if (!(focus > n)) focus = std::max(n * 10.0f, 1.0f);
+    shift = eyeOffset * n / focus;
+  }
+  t.projection = Mat4::frustum(-halfW - shift, halfW - shift, -halfH, halfH, n, f);
+  return t;
+}
+
+}  // namespace
+
 ViewTransforms computeEyeView(const Show& show, float aspect, float eyeOffset) {
+  if (show.viewer().framing == Framing::kScene) return sceneCameraView(show, aspect, eyeOffset);
   const ViewSettings& v = show.view();
   ViewTransforms t;
   t.model = show.position().global * show.position().local * viewNormalisation(show);
+
+  // The walking viewer moves from LAVA's eye, its scene units scaled into window units.
+  const Viewer& walker = show.viewer();
+  const float walkScale = uniformScale(t.model);
+  const Mat4 walk = cameraTransform(walker.position * (walkScale > 0 && std::isfinite(walkScale) ? walkScale : 1.0f),
+                                    walker.rotation);
 
   // Window bounds -1..1 at the narrower dimension, shrunk or grown by the view scale.
   const float viewScale = v.viewScale > 0 ? v.viewScale : 1.0f;
@@ -285,8 +328,9 @@ ViewTransforms computeEyeView(const Show& show, float aspect, float eyeOffset) {
   const float e = eyeOffset;
   if (v.perspective > 0) {
     const float d = v.perspective;
-    t.eye = {e, 0, d};
-    t.view = Mat4::translation({-e, 0, -d});
+    const Mat4 eye = Mat4::translation({0, 0, d}) * walk * Mat4::translation({e, 0, 0});
+    t.eye = eye.transformPoint({0, 0, 0});
+    t.view = eye.inverted();
     const float n = std::max(d - zClip, d * 1e-3f);
     const float f = d + zClip;
     // The window -halfW..halfW on the z = 0 plane, seen from the (moved) eye: an off-axis frustum.
@@ -294,8 +338,9 @@ ViewTransforms computeEyeView(const Show& show, float aspect, float eyeOffset) {
     t.projection = Mat4::frustum((-halfW - e) * k, (halfW - e) * k, -halfH * k, halfH * k, n, f);
   } else {
     const float d = zClip + 1.0f;
-    t.eye = {e, 0, d};
-    t.view = Mat4::translation({0, 0, -d});
+    const Mat4 eye = Mat4::translation({0, 0, d}) * walk;
+    t.eye = eye.transformPoint({e, 0, 0});
+    t.view = eye.inverted();
     // Parallel eyes see no parallax, so the eye's view is sheared instead: a point z window units
     // in front of the centre plane moves by -e z / d, as it would seen in perspective from d.
     Mat4 shear;

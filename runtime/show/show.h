@@ -274,18 +274,27 @@ struct ViewTransforms {
   Vec3 eye;         ///< eye position in world coordinates
 };
 
-/// \brief LAVA's view (§6.1 "View"): the scene centred and scaled into window bounds -1..1 at the
-/// narrower dimension, seen from `view().perspective` units away on +Z (orthographic at 0).
+/// \brief The plain view, framed as `viewer().framing` says.
+///
+/// Framing::kFit is LAVA's view (§6.1 "View"): the scene centred and scaled into window bounds
+/// -1..1 at the narrower dimension, seen from `view().perspective` units away on +Z
+/// (orthographic at 0), the walking viewer's moves (its position scaled into window units, its
+/// rotation) applied at that eye. Framing::kScene is the thesis' camera (§4.3.1): the scene in
+/// its own units seen from `viewer().position` turned by `viewer().rotation` (cameraTransform)
+/// through a symmetric frustum of `fieldOfView` degrees vertically at `aspect`, between
+/// `nearClip` and `farClip`.
 ViewTransforms computeView(const Show& show, float aspect);
 
 /// \brief One eye of a stereo pair (thesis §5.1): the eye moved `eyeOffset` window units along
-/// X (negative: left eye) from computeView()'s eye, with an off-axis frustum that keeps the
-/// object's centre plane (z = 0) where the mono view shows it, so the two images agree there
-/// and differ in front of and behind it. Orthographic views are sheared the same way.
+/// the eye's X axis (negative: left eye) from computeView()'s eye, with an off-axis frustum that
+/// keeps the object's centre plane where the mono view shows it, so the two images agree there
+/// and differ in front of and behind it (for a scene camera: the plane through the centre of
+/// the scene's bounds, across the line of sight). Orthographic views are sheared the same way.
 ViewTransforms computeEyeView(const Show& show, float aspect, float eyeOffset);
 
 /// \brief The scene's normalisation (centre and scale into window units, LAVA "View"): what
-/// computeView() puts between the scene and the local matrix.
+/// computeView() puts between the scene and the local matrix. Identity for a scene drawn from
+/// its own camera (Framing::kScene).
 Mat4 viewNormalisation(const Show& show);
 
 /// \brief The uniform scale of a transform: the cube root of its 3 x 3 determinant's magnitude

@@ -4,6 +4,11 @@
 
 namespace basalt::runtime {
 
+Mat4 cameraTransform(const Vec3& position, const Vec3& rotationDegrees) {
+  return Mat4::translation(position) * Mat4::rotationY(rotationDegrees.y) * Mat4::rotationX(rotationDegrees.x) *
+         Mat4::rotationZ(rotationDegrees.z);
+}
+
 std::optional<float> HeightField::heightAt(float x, float z) const {
   if (columns < 2 || rows < 2 || spacing <= 0 || heights.size() < std::size_t{columns} * rows) return std::nullopt;
   const float u = (x - origin.x) / spacing;

@@ -13,9 +13,26 @@
 
 namespace basalt::runtime {
 
+/// \brief How the world is framed in a view.
+enum class Framing : std::uint8_t {
+  /// LAVA's view (§6.1 "View"): the world centred and shrunk or grown into window units, seen
+  /// from LAVA's eye; the viewer walks from that eye, its moves scaled into window units.
+  kFit,
+  /// The thesis' camera (§4.3.1, F.1): the world in its own units, seen from `position` turned
+  /// by `rotation`, through `fieldOfView`, `nearClip`, `farClip` and the scene's viewport.
+  kScene,
+};
+
 /// \brief The viewer a scene file sets (thesis C.3 and Appendix F.1). Defaults are the thesis'.
+///
+/// The camera's orientation (`rotation`, F.1 "Euler rotation angles (X, Y, Z)") is read as a
+/// walking viewer's: the camera looks down -Z with +Y up, turned `rotation.y` degrees about the
+/// world's Y axis (heading, positive to the left), then `rotation.x` about its own X axis
+/// (positive looks up), then `rotation.z` about its line of sight: world-from-camera =
+/// T(position) Ry Rx Rz (cameraTransform).
 struct Viewer {
-  bool fromScene = false;            ///< a scene set this viewer (LAVA's object view applies otherwise)
+  bool fromScene = false;            ///< a scene or walking set this viewer
+  Framing framing = Framing::kFit;   ///< a scene's own camera and units, or LAVA's fit to the window
   Vec3 position{0, 0, 0};            ///< `position[x,y,z]`: initial eye position
   Vec3 rotation{0, 0, 0};            ///< `rotation[x,y,z]`: Euler angles in degrees, X then Y then Z
   float fieldOfView = 60.0f;         ///< `projection fov[]`, degrees (unused on cave facets)
@@ -34,6 +51,10 @@ struct Viewer {
   bool followTerrain = false;  ///< keep the eye at terrain height (a scene with a terrain sets it)
   friend bool operator==(const Viewer&, const Viewer&) = default;
 };
+
+/// \brief Where the viewer's camera is and how it is turned: world-from-camera, T(position) Ry
+/// Rx Rz (see Viewer). Rigid.
+Mat4 cameraTransform(const Vec3& position, const Vec3& rotationDegrees);
 
 /// \brief A terrain's heights on a regular grid in the XZ plane (thesis §4.6): sample (i, j) is
 /// at x = origin.x + i * spacing, z = origin.z + j * spacing, height origin.y + heights[j*columns+i].

@@ -77,6 +77,19 @@ TEST(CheckCli, TheFileLineCountsWhatIsPrinted) {
   EXPECT_NE(warned.output.find(": 0 errors, 1 warning; ok: '"), std::string::npos) << warned.output;
 }
 
+// Makes sure `basalt check scene.sce` names, at its line, a camera value the scene cannot be
+// drawn with as written. Example failure: a viewport with no resolution passing the check and
+// then silently filling the view.
+TEST(CheckCli, ASceneCameraItCannotHonourIsNamedAtItsLine) {
+  const fs::path dir = test::scratchDir("check-cli-scene-camera");
+  writeFile(dir / "box.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n");
+  writeFile(dir / "s.sce", "import box.obj\nviewport position[10,10]\nprojection fov[50]\n");
+  const std::string file = (dir / "s.sce").string();
+  const auto r = check({file});
+  EXPECT_EQ(linesWith(r.output, file + ":2:"), 1u) << r.output;
+  EXPECT_NE(r.output.find("the viewport has no area"), std::string::npos) << r.output;
+}
+
 TEST(CheckCli, SeveralFilesAddUp) {
   const fs::path dir = test::scratchDir("check-cli-several");
   writeFile(dir / "a" / "show.toml", kTwoErrorsOneWarning);

@@ -1,5 +1,5 @@
 // A `.sce` scene's lights, materials, fog and instances drawn the way the thesis defines them,
-// through the loader and the frame loop's LAVA view (the scene fitted into the window), each
+// through the loader and LAVA's view (the scene fitted into the window, view = "fit"), each
 // pixel compared with a value worked out by hand below from the thesis' equations.
 //
 // The thesis, §4.2.4: "In calculating color for a vertex, OpenGL starts with the material
@@ -66,6 +66,10 @@ runtime::Show loadShow(const std::string& name, const std::string& scene,
   std::vector<formats::Diagnostic> warnings;
   formats::applyScene(show, *loaded, &warnings);
   EXPECT_TRUE(warnings.empty());
+  // Framed as LAVA frames a model (a manifest's view = "fit"): the values below are worked out
+  // for LAVA's eye, and lights and fog must keep the scene's units under that framing too.
+  // scene_camera_gl_test.cpp checks the scene's own camera.
+  formats::useFitFraming(show);
   return show;
 }
 

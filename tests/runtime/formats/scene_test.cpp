@@ -45,6 +45,36 @@ Result<SceneDescription> parse(std::string_view text, std::vector<Diagnostic>& w
   return parseSceneText(text, name, test::quiet(), warnings);
 }
 
+// Makes sure a scene whose camera lines parse but cannot be honoured as written says so at the
+// line (what `basalt check` shows). Example failure: a viewport without a resolution silently
+// drawn over the whole view; a start outside the map bounds silently jumping at the first step.
+TEST(Scene, CameraValuesThatCannotBeHonouredAreNamedAtTheirLine) {
+  struct Case {
+    const char* text;
+    const char* where;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"# a viewport with no size\nviewport position[10,10]\n", "s.sce:2:", "no area"},
+      {"mapmin[0,0,0]\nmapmax[10,10,10]\n\nposition[20,1,1]\n", "s.sce:4:", "outside mapmin..mapmax"},
+      {"mapmin[0,0,0]\nmapmax[10,-1,10]\n", "s.sce:2:", "mapmin is beyond mapmax"},
+      {"\nprojection fov[60] nearclip[0.0001] farclip[1000]\n", "s.sce:2:", "raise nearclip"},
+  };
+  for (const Case& c : cases) {
+    std::vector<Diagnostic> warnings;
+    ASSERT_TRUE(parse(c.text, warnings)) << c.text;
+    ASSERT_EQ(warnings.size(), 1u) << c.text << listWarnings(warnings);
+    EXPECT_TRUE(warnings[0].where.starts_with(c.where)) << warnings[0].describe();
+    EXPECT_NE(warnings[0].message.find(c.says), std::string::npos) << warnings[0].describe();
+  }
+  std::vector<Diagnostic> none;
+  ASSERT_TRUE(
+      parse("viewport position[0,0] resolution[640,480]\nprojection fov[40] nearclip[0.5] farclip[500]\n"
+            "mapmin[-10,-10,-10]\nmapmax[10,10,10]\nposition[1,2,3]\n",
+            none));
+  EXPECT_TRUE(none.empty()) << listWarnings(none);
+}
+
 // Found by fuzzing: `eyespacing[-6` then a byte that ends no number was skipped with a warning,
 // yet the -6 read before the bad byte stayed in the scene (and a negative eye spacing, which the
 // reader otherwise replaces, was written back). A skipped statement changes nothing.
@@ -232,6 +262,7 @@ TEST(SceneFiles, LoadImportsEverythingAndTheShowGetsIt) {
   EXPECT_EQ(show.viewer().fieldOfView, 45.0f);
   EXPECT_EQ(show.viewer().viewportWidth, 640);
   EXPECT_TRUE(show.viewer().fromScene);
+  EXPECT_EQ(show.viewer().framing, runtime::Framing::kScene) << "drawn from its own camera";
   EXPECT_TRUE(show.viewer().followTerrain);
   // The terrain: heights from the map scaled by the amplitude, placed at its position.
   auto h = show.terrainHeightAt(-1, -1);
@@ -316,8 +347,9 @@ TEST(SceneFiles, AnInstanceKeepsItsOwnMaterialAndTheOriginalItsOwn) {
 }
 
 TEST(SceneFiles, ScaledScenesKeepTheirEyeSpacingInSceneUnits) {
-  // A 0..10 square: its bounds' radius is 5 sqrt 2, so one scene unit is 1 / (5 sqrt 2) window
-  // units, and eyespacing[2] puts the eyes 2 / (5 sqrt 2) = 0.282843 window units apart.
+  // Seen from its own camera a scene keeps its units: eyespacing[2] is 2 world units. Fitted
+  // into LAVA's window (view = "fit"), a 0..10 square's bounds have radius 5 sqrt 2, so one scene
+  // unit is 1 / (5 sqrt 2) window units, and the eyes are 2 / (5 sqrt 2) = 0.282843 apart.
   const auto dir = basalt::test::scratchDir("scene-eyespacing");
   std::ofstream(dir / "sq.obj") << "v 0 0 0\nv 10 0 0\nv 10 10 0\nv 0 10 0\nf 1 2 3 4\n";
   std::ofstream(dir / "s.sce") << "eyespacing[2]\nimport sq.obj\n";
@@ -325,6 +357,8 @@ TEST(SceneFiles, ScaledScenesKeepTheirEyeSpacingInSceneUnits) {
   ASSERT_TRUE(scene);
   runtime::Show show;
   applyScene(show, *scene);
+  EXPECT_NEAR(runtime::eyeSpacingInWindowUnits(show), 2.0, 1e-5) << "the scene's own camera";
+  useFitFraming(show);
   EXPECT_NEAR(runtime::eyeSpacingInWindowUnits(show), 2.0 / (5.0 * std::sqrt(2.0)), 1e-5);
   show.stereo().units = runtime::Units::kWindow;
   EXPECT_FLOAT_EQ(runtime::eyeSpacingInWindowUnits(show), 2.0f) << "LAVA's spacing is in window units";
