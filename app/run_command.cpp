@@ -37,6 +37,7 @@
 #include "kiosk/policy/state_store.h"
 #include "kiosk/policy/supervisor.h"
 #include "kiosk/show/device_wiring.h"
+#include "kiosk/show/osc_trackers.h"
 #include "kiosk/show/script_player.h"
 #include "kiosk/show/show_director.h"
 #include "kiosk/show/show_loader.h"
@@ -858,6 +859,16 @@ int runShow(const RunOptions& options) {
 
   // Texture images are read in the background: the first frame does not wait for them.
   ShowFactories factories = showFactories();
+  // Trackers fed by OSC (/tracker/NAME): one set of feeds for the run, both the OSC input's
+  // tracker sink and the provider the DeviceManager opens those trackers from.
+  std::shared_ptr<OscTrackerFeeds> oscTrackers;
+  if (const std::vector<std::string> names = OscTrackerFeeds::namesIn(manifest); !names.empty()) {
+    oscTrackers = std::make_shared<OscTrackerFeeds>(names, clock);
+    factories.devices = [inner = factories.devices, oscTrackers](const DeviceSpec& spec) -> Result<DeviceSource> {
+      if (spec.backend == DeviceBackend::kOsc) return oscTrackers->sourceFor(spec);
+      return inner(spec);
+    };
+  }
   auto loaded = loadShow(manifest, clock, factories, false);
   if (!loaded && options.manifest && !options.strict && !(fallback && fallback->card)) {
     // The entry has errors (a script that does not parse): the last good copy plays, or the card.
@@ -949,7 +960,7 @@ int runShow(const RunOptions& options) {
   std::unique_ptr<OscInput> oscInput;
   std::unique_ptr<OscOutput> oscOutput;
   if (manifest.osc.enabled) {
-    auto started = OscInput::start(manifest.osc, board);
+    auto started = OscInput::start(manifest.osc, board, oscTrackers.get());
     if (started) {
       oscInput = std::move(*started);
       fmt::print("basalt: osc: {}\n", oscInput->describe());

@@ -117,6 +117,7 @@ std::string_view deviceBackendName(DeviceBackend backend) {
     case DeviceBackend::kSynthetic: return "synthetic";
     case DeviceBackend::kSerial: return "serial";
     case DeviceBackend::kMidi: return "midi";
+    case DeviceBackend::kOsc: return "osc";
   }
   return "?";
 }
@@ -731,6 +732,13 @@ class Reader {
     if (const toml::table* t = table(root, "input", "")) readInput(*t);
     if (const toml::table* t = table(root, "lock", "")) readLock(*t);
     if (const toml::table* t = table(root, "osc", "")) readOsc(*t);
+    for (const DeviceSpec& d : manifest_.devices) {
+      if (d.backend == DeviceBackend::kOsc && !manifest_.osc.enabled) {
+        error(d.line, fmt::format("devices.{}: an osc tracker takes /tracker/{} messages from the show's OSC input; "
+                                  "add an [osc] table (listen = \"127.0.0.1:9000\")",
+                                  d.name, d.match.name.empty() ? d.name : d.match.name));
+      }
+    }
 
     // By line, keeping the order of problems found on the same line.
     std::vector<std::size_t> order(diagsOwn_.size());
@@ -1369,13 +1377,14 @@ class Reader {
                                                  {{"hid", DeviceBackend::kHid},
                                                   {"serial", DeviceBackend::kSerial},
                                                   {"midi", DeviceBackend::kMidi},
+                                                  {"osc", DeviceBackend::kOsc},
                                                   {"v4l2", DeviceBackend::kV4l2},
                                                   {"libcamera", DeviceBackend::kLibcamera},
                                                   {"replay", DeviceBackend::kReplay},
                                                   {"synthetic", DeviceBackend::kSynthetic}});
       if (!t->get("backend")) {
-        error(d.line, fmt::format("{}: needs backend = \"hid\", \"serial\", \"midi\", \"v4l2\", \"libcamera\", "
-                                  "\"replay\" or \"synthetic\"",
+        error(d.line, fmt::format("{}: needs backend = \"hid\", \"serial\", \"midi\", \"osc\", \"v4l2\", "
+                                  "\"libcamera\", \"replay\" or \"synthetic\"",
                                   path));
       }
       if (backend) d.backend = *backend;
@@ -1383,16 +1392,16 @@ class Reader {
         const bool dialBackend = *backend == DeviceBackend::kHid || *backend == DeviceBackend::kReplay ||
                                  *backend == DeviceBackend::kSynthetic || *backend == DeviceBackend::kSerial ||
                                  *backend == DeviceBackend::kMidi;
-        const bool cameraBackend =
-            *backend != DeviceBackend::kHid && *backend != DeviceBackend::kSerial && *backend != DeviceBackend::kMidi;
+        const bool cameraBackend = *backend != DeviceBackend::kHid && *backend != DeviceBackend::kSerial &&
+                                   *backend != DeviceBackend::kMidi && *backend != DeviceBackend::kOsc;
         const bool trackerBackend = *backend == DeviceBackend::kHid || *backend == DeviceBackend::kReplay ||
-                                    *backend == DeviceBackend::kSynthetic;
+                                    *backend == DeviceBackend::kSynthetic || *backend == DeviceBackend::kOsc;
         if ((*kind == DeviceKind::kDialBox && !dialBackend) || (*kind == DeviceKind::kCamera && !cameraBackend) ||
             (*kind == DeviceKind::kTracker && !trackerBackend)) {
           error(lineOf(*t->get("backend")),
                 fmt::format("{}: a {} cannot use the {} backend; a dial_box uses hid, serial, midi, replay or "
-                            "synthetic, a camera v4l2, libcamera, replay or synthetic, a tracker hid, replay or "
-                            "synthetic",
+                            "synthetic, a camera v4l2, libcamera, replay or synthetic, a tracker hid, osc, replay "
+                            "or synthetic",
                             path, deviceKindName(*kind), deviceBackendName(*backend)));
         }
       }

@@ -186,7 +186,7 @@ struct MediaSpec {
 };
 
 enum class DeviceKind : std::uint8_t { kDialBox, kCamera, kTracker };
-enum class DeviceBackend : std::uint8_t { kHid, kV4l2, kLibcamera, kReplay, kSynthetic, kSerial, kMidi };
+enum class DeviceBackend : std::uint8_t { kHid, kV4l2, kLibcamera, kReplay, kSynthetic, kSerial, kMidi, kOsc };
 std::string_view deviceKindName(DeviceKind kind);
 std::string_view deviceBackendName(DeviceBackend backend);
 
@@ -249,7 +249,7 @@ struct DeviceSpec {
   /// midi dial box: `midi = { profile, encoding, channel, dials, buttons, notes, nrpn,
   /// high_resolution, echo }` as the backend's options (devices/midi/midi_backend.h), checked
   std::map<std::string, std::string> midi;
-  TrackerMotion motion;                ///< synthetic tracker: its path
+  TrackerMotion motion;  ///< synthetic tracker: its path
   int line = 0;
 };
 

@@ -711,6 +711,10 @@ Result<std::unique_ptr<devices::DeviceProvider>> providerFor(const DeviceSpec& s
   switch (spec.backend) {
     case DeviceBackend::kHid: return std::make_unique<devices::HidProvider>();
     case DeviceBackend::kMidi: return std::make_unique<devices::MidiProvider>();
+    case DeviceBackend::kOsc:
+      return fail(
+          Errc::kUnavailable,
+          fmt::format("the tracker '{}' is fed by the run's OSC input (OscTrackerFeeds), not opened alone", spec.name));
     case DeviceBackend::kV4l2: return std::make_unique<devices::V4l2Provider>();
     case DeviceBackend::kLibcamera: return std::make_unique<devices::LibcameraProvider>();
     case DeviceBackend::kSynthetic: return std::make_unique<sim::SyntheticProvider>();
