@@ -733,7 +733,7 @@ class Reader {
     if (const toml::table* t = table(root, "lock", "")) readLock(*t);
     if (const toml::table* t = table(root, "osc", "")) readOsc(*t);
     for (const DeviceSpec& d : manifest_.devices) {
-      if (d.backend == DeviceBackend::kOsc && !manifest_.osc.enabled) {
+      if (d.kind == DeviceKind::kTracker && d.backend == DeviceBackend::kOsc && !manifest_.osc.enabled) {
         error(d.line, fmt::format("devices.{}: an osc tracker takes /tracker/{} messages from the show's OSC input; "
                                   "add an [osc] table (listen = \"127.0.0.1:9000\")",
                                   d.name, d.match.name.empty() ? d.name : d.match.name));

@@ -479,8 +479,20 @@ TEST(ManifestErrors, DevicesAreCoherent) {
   EXPECT_TRUE(hasError(r, 9, "'77d:410' is not VVVV:PPPP")) << r.text;
   EXPECT_TRUE(hasError(r, 10, "the replay backend needs trace")) << r.text;
   EXPECT_TRUE(hasError(r, 16, "has no trace.toml")) << r.text;
-  EXPECT_TRUE(hasError(r, 19, "'bluetooth' is not one of hid, serial, midi, v4l2, libcamera, replay or synthetic"))
+  EXPECT_TRUE(hasError(r, 19, "'bluetooth' is not one of hid, serial, midi, osc, v4l2, libcamera, replay or synthetic"))
       << r.text;
+  // A tracker fed by OSC needs the show's OSC input; a camera cannot be fed so.
+  const auto osc = f.read(
+      "[devices.head]\nkind = \"tracker\"\nbackend = \"osc\"\n"
+      "[devices.eye]\nkind = \"camera\"\nbackend = \"osc\"\n");
+  EXPECT_TRUE(hasError(osc, 1, "an osc tracker takes /tracker/head messages from the show's OSC input")) << osc.text;
+  EXPECT_TRUE(hasError(osc, 6, "a camera cannot use the osc backend")) << osc.text;
+  const auto fed = f.read(
+      "[devices.head]\nkind = \"tracker\"\nbackend = \"osc\"\nmatch = { name = \"hmd\" }\n"
+      "[osc]\nlisten = \"127.0.0.1:9000\"\n");
+  ASSERT_TRUE(fed.manifest) << fed.text;
+  EXPECT_EQ(fed.manifest->devices[0].backend, DeviceBackend::kOsc);
+  EXPECT_EQ(fed.manifest->devices[0].match.name, "hmd");
   const auto ok = f.read("[devices.d]\nkind = \"dial_box\"\nbackend = \"replay\"\ntrace = \"site.trace\"\n");
   ASSERT_TRUE(ok.manifest) << ok.text;
   EXPECT_EQ(ok.manifest->devices[0].trace, fs::canonical(f.dir / "site.trace"));
