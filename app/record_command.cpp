@@ -19,7 +19,9 @@
 #include "kiosk/show/trace_video_glue.h"
 #include "runtime/event_loop.h"
 #include "runtime/log.h"
+#include "sim/providers.h"
 #include "sim/raw_video.h"
+#include "sim/synthetic_tracker.h"
 #include "sim/trace.h"
 
 namespace basalt::kiosk {
@@ -159,6 +161,8 @@ Options:
                     serial:/dev/ttyUSB0, midi:X-TOUCH MINI, midi:seq:24:0, synthetic
   --camera SPEC     a video source to record (repeatable): v4l2:/dev/video0, v4l2:NAME,
                     libcamera, synthetic
+  --tracker SPEC    a head or object tracker to record (repeatable): hid, hid:VVVV:PPPP,
+                    hid:/dev/hidraw3, synthetic (a head going round a circle)
   --synthetic       record the synthetic dial box and camera (a demo trace, no hardware needed)
   --seconds S       stop after S seconds (default: until Ctrl-C or SIGTERM)
   --fast            run on a manual clock as fast as possible (synthetic devices only)
@@ -188,6 +192,7 @@ int recordMain(std::span<const std::string_view> args) {
                               {"--output", true},
                               {"--dial", true},
                               {"--camera", true},
+                              {"--tracker", true},
                               {"--synthetic"},
                               {"--seconds", true},
                               {"--fast"},
@@ -202,7 +207,8 @@ int recordMain(std::span<const std::string_view> args) {
   double fps = 60;
   bool rawVideo = false;
   std::uint64_t keepFree = kDefaultKeepFree;
-  int dials = 0, cameras = 0;
+  int dials = 0, cameras = 0, trackers = 0;
+  bool syntheticTracker = false;
   for (const ParsedOption& o : *parsed) {
     if (o.name.empty()) return usageError(fmt::format("unexpected argument '{}'; see 'basalt record --help'", o.value));
     if (o.name == "--help") {
@@ -232,6 +238,20 @@ int recordMain(std::span<const std::string_view> args) {
       }
       if (!r) return usageError(r.error().describe());
     }
+    if (o.name == "--tracker") {
+      std::string name = "tracker";
+      if (++trackers > 1) name += std::to_string(trackers);
+      auto r = parseDeviceSpec(o.value, devices::DeviceKind::kTracker, name);
+      if (!r) return usageError(r.error().describe());
+      if (r->match.backend != "hid" && r->match.backend != "synthetic") {
+        return usageError(fmt::format("--tracker {}: a tracker is recorded from hid or synthetic", o.value));
+      }
+      if (r->match.backend == "synthetic") {
+        syntheticTracker = true;
+        r->match.path = sim::SyntheticTracker::defaultInfo().path;
+      }
+      requests.push_back(std::move(*r));
+    }
     if (o.name == "--seconds") {
       auto v = numberOption(o.name, o.value, 0.01, 1e7);
       if (!v) return usageError(v.error().describe());
@@ -251,7 +271,8 @@ int recordMain(std::span<const std::string_view> args) {
   }
   if (output.empty()) return usageError("basalt record needs --output NAME.trace; see 'basalt record --help'");
   if (requests.empty()) {
-    return usageError("nothing to record: give --dial, --camera or --synthetic; 'basalt devices' lists what is there");
+    return usageError(
+        "nothing to record: give --dial, --camera, --tracker or --synthetic; 'basalt devices' lists what is there");
   }
   if (fast && !seconds) return usageError("--fast needs --seconds (a manual clock never reaches Ctrl-C)");
   if (fast) {
@@ -290,7 +311,16 @@ int recordMain(std::span<const std::string_view> args) {
   }
   BoundedQueue<Event> events(4096);  // the devices' events: the recorder taps the reports instead
   DeviceWiring wiring(clock, events);
-  for (auto& p : allProviders()) wiring.manager().addProvider(std::move(p));
+  for (auto& p : allProviders()) {
+    if (auto* synthetic = dynamic_cast<sim::SyntheticProvider*>(p.get()); synthetic && syntheticTracker) {
+      // The simulated tracker: a head going round a circle (sim::TrackerPath's defaults).
+      sim::SyntheticProvider::Device tracker;
+      tracker.candidate = {sim::SyntheticTracker::defaultInfo(), devices::DeviceKind::kTracker, "",
+                           "a head going round a circle"};
+      synthetic->plug(std::move(tracker));
+    }
+    wiring.manager().addProvider(std::move(p));
+  }
   for (auto& r : requests) {
     if (auto id = wiring.manager().request(r); !id) return usageError(id.error().describe());
   }
@@ -329,6 +359,8 @@ int recordMain(std::span<const std::string_view> args) {
       if (s.state != devices::DeviceState::kLive || registered.contains(s.id)) continue;
       Result<void> r = s.kind == devices::DeviceKind::kDialBox
                            ? (*recorder)->addDialBox(s.id, s.name, s.device, s.reportDescriptor)
+                       : s.kind == devices::DeviceKind::kTracker
+                           ? (*recorder)->addTracker(s.id, s.name, s.device, s.reportDescriptor)
                            : (*recorder)->addVideoSource(s.id, s.name, s.device, s.mode.value_or(devices::VideoMode{}));
       if (!r) {
         failure = fmt::format("cannot record {}: {}", s.name, r.error().describe());

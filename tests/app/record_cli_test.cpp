@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
 #include <regex>
 #include <string>
 #include <vector>
@@ -197,6 +198,30 @@ TEST(RecordCli, ATraceThatCannotBeFinishedIsRemoved) {
       std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(trace)) << "nothing is left to block the next try";
+}
+
+// Makes sure a tracker is recorded as dial boxes and cameras are: `basalt record --tracker
+// synthetic` writes the simulated head's samples into the trace as a tracker, in the
+// hid-recorder format a replay reads back. At 60 fps of a manual clock for 2 s the synthetic
+// tracker gives one sample a frame.
+// Example failure: --tracker refused, or the tracker opened but never registered with the
+// recorder (no file in the trace, "tracker was never live").
+TEST(RecordCli, RecordsATracker) {
+  const fs::path trace = test::scratchDir("record-cli-tracker") / "head.trace";
+  const auto r = record({"--tracker", "synthetic", "--fast", "--seconds", "2", "--output", trace.string()});
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("recording tracker from"), std::string::npos) << r.output;
+  auto info = sim::readTrace(trace);
+  ASSERT_TRUE(info) << info.error().describe();
+  ASSERT_EQ(info->devices.size(), 1u);
+  EXPECT_EQ(info->devices[0].kind, devices::DeviceKind::kTracker);
+  std::ifstream file(trace / info->devices[0].file);
+  std::size_t events = 0;
+  for (std::string line; std::getline(file, line);) events += line.starts_with("E: ");
+  EXPECT_GE(events, 100u) << "about one sample a frame over 2 s at 60 fps";
+  const auto bad = record({"--tracker", "v4l2:/dev/video0", "--seconds", "1", "--output", trace.string()});
+  EXPECT_EQ(bad.exitCode, 2) << bad.output;
+  EXPECT_NE(bad.output.find("a tracker is recorded from hid or synthetic"), std::string::npos) << bad.output;
 }
 
 }  // namespace
