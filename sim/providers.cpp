@@ -5,10 +5,10 @@
 #include <fmt/format.h>
 
 #include "devices/hid/dial_decoder.h"
-#include "devices/midi/midi_decoder.h"
-#include "sim/midi_file.h"
 #include "devices/hid/report_descriptor.h"
 #include "devices/hid/tracker_decoder.h"
+#include "devices/midi/midi_decoder.h"
+#include "sim/midi_file.h"
 #include "sim/raw_video.h"
 #include "sim/replay.h"
 #include "sim/replay_tracker.h"

@@ -197,9 +197,9 @@ struct ControlReply {
 
 struct ControlRequest {
   ControlKind kind = ControlKind::kNext;
-  std::string argument;                             ///< the command, the device's name, calibration statements or a set-up toggle
-  std::string view;                                 ///< kCalibrate: the facet view ("" = the first)
-  bool save = false;                                ///< kCalibrate: write the calibration back to the cave file
+  std::string argument;  ///< the command, the device's name, calibration statements or a set-up toggle
+  std::string view;      ///< kCalibrate: the facet view ("" = the first)
+  bool save = false;     ///< kCalibrate: write the calibration back to the cave file
   runtime::Action action = runtime::Action::kNone;  ///< kAction
   float amount = 0;                                 ///< kAction: in the action's units (runtime::applyAction)
   std::shared_ptr<ControlReply> reply;

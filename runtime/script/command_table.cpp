@@ -920,7 +920,11 @@ std::vector<CommandDef> buildTable() {
                   .tv(TvOp::kShuttle)
                   .doc("N frames on, or back when negative"));
   t.push_back(Def("tv.repeat").assignment().onOff().tv(TvOp::kRepeat).doc("loop the movie"));
-  t.push_back(Def("tv.camera").assignment().onOff().tv(TvOp::kCamera).doc("the live camera on or off: the camera of basalt run --camera, else the manifest's first"));
+  t.push_back(Def("tv.camera")
+                  .assignment()
+                  .onOff()
+                  .tv(TvOp::kCamera)
+                  .doc("the live camera on or off: the camera of basalt run --camera, else the manifest's first"));
   return t;
 }
 
