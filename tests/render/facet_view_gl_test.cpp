@@ -61,8 +61,9 @@ class FacetViews : public RenderTest {
 
   Image drawFacet(const Show& show, const formats::CaveFacet& facet, bool stereo = false,
                   runtime::StereoMode mode = runtime::StereoMode::kAnaglyph, float spacing = 0.2f,
-                  const formats::CaveSettings& calibration = {}) {
+                  const formats::CaveSettings& calibration = {}, Vec3 eyeAxis = {}) {
     render::FacetPass pass;
+    pass.eyeAxis = eyeAxis;
     pass.facet = &facet;
     pass.input.worldFromCave = runtime::cavePlacement(show);
     pass.input.calibration = calibration;
@@ -208,6 +209,57 @@ TEST_F(FacetViews, StereoLayoutsPutEachEyeInItsPlace) {
   EXPECT_TRUE(notBackground(topBottom, kRenderSize / 2, 3 * kRenderSize / 4));
   EXPECT_TRUE(notBackground(sideBySide, kRenderSize / 4, kRenderSize / 2));
   EXPECT_TRUE(notBackground(sideBySide, 3 * kRenderSize / 4, kRenderSize / 2));
+}
+
+// Thesis §4.4.3 offsets each eye from the viewer along the view's right; a tracked head turns
+// the eyes with it (FacetPass::eyeAxis, the head's right vector). Side by side, each eye's
+// picture of the cube sits apart from the other's along the direction the eyes are apart. With
+// no head (the view's right) the cube moves sideways between the halves and not up or down. Of
+// the two cave axes across this facet, the one along the view's right gives that same shift, and
+// the other, a head rolled a quarter turn, moves the cube up or down instead (by twice as many
+// pixels: side by side halves the width).
+// Example failure: the eyes always along the view's right, whatever the head does.
+TEST_F(FacetViews, StereoEyesSitAlongTheTrackedHeadsRightVector) {
+  const Show show = greyShow();
+  const formats::CaveGeometry cube = geometryOf(cubeDisplayObj());
+  // How far the cube's picture moves from the left eye's half to the right eye's: the centres of
+  // the pixels that are neither the background nor the border.
+  const auto shift = [&](Vec3 axis) {
+    const Image im = drawFacet(show, cube.facets[5], true, runtime::StereoMode::kSideBySide, 0.4f, {}, axis);
+    std::array<double, 2> centre[2] = {};
+    for (std::uint32_t half = 0; half < 2; ++half) {
+      double sx = 0, sy = 0, n = 0;
+      for (std::uint32_t y = 0; y < kRenderSize; ++y) {
+        for (std::uint32_t x = 0; x < kRenderSize / 2; ++x) {
+          const std::uint32_t px = x + half * kRenderSize / 2;
+          const int r = im.at(px, y, 0), g = im.at(px, y, 1), b = im.at(px, y, 2);
+          const bool background = std::abs(r - 77) <= 3 && std::abs(g - 102) <= 3 && std::abs(b - 128) <= 3;
+          if (background || r + g + b == 0) continue;
+          sx += x;
+          sy += y;
+          n += 1;
+        }
+      }
+      EXPECT_GT(n, 500) << "the cube shows in each half";
+      centre[half] = {n > 0 ? sx / n : 0, n > 0 ? sy / n : 0};
+    }
+    return std::array<double, 2>{centre[1][0] - centre[0][0], centre[1][1] - centre[0][1]};
+  };
+  const auto plain = shift({});
+  EXPECT_GT(std::abs(plain[0]), 1.0) << "the view's right: the cube moves sideways";
+  EXPECT_LT(std::abs(plain[1]), 0.5) << "the view's right: not up or down";
+  const auto alongX = shift({1, 0, 0});
+  const auto alongY = shift({0, 1, 0});
+  // One cave axis lies along the facet's horizontal, the other along its vertical.
+  const bool xIsRight = std::abs(alongX[0]) > std::abs(alongX[1]);
+  const auto& right = xIsRight ? alongX : alongY;
+  const auto& rolled = xIsRight ? alongY : alongX;
+  EXPECT_NEAR(std::abs(right[0]), std::abs(plain[0]), 0.5) << "the head's right along the view's: the same shift";
+  EXPECT_LT(std::abs(right[1]), 0.5);
+  EXPECT_GT(std::abs(rolled[1]), 1.0) << "a rolled head: the cube moves up or down between the eyes";
+  EXPECT_LT(std::abs(rolled[0]), std::abs(rolled[1]) / 4) << "a rolled head: hardly sideways";
+  EXPECT_NEAR(std::abs(rolled[1]), 2 * std::abs(plain[0]), 0.25 * std::abs(plain[0]))
+      << "the same eye spacing, twice the pixels up the full height as across the halved width";
 }
 
 TEST_F(FacetViews, PlainViewsHonourThePassiveStereoLayouts) {
