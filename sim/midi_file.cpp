@@ -202,8 +202,11 @@ Result<HidRecordedDevice> parseMidiFile(std::span<const std::uint8_t> bytes, std
     }
     r.pos_ = r.end_;
   }
-  std::stable_sort(messages.begin(), messages.end(),
-                   [](const TimedMessage& a, const TimedMessage& b) { return a.tick < b.tick; });
+  // std::sort on (tick, file order) rather than std::stable_sort, whose temporary buffer
+  // (std::get_temporary_buffer) is deprecated in C++17 and flagged by clang-tidy.
+  std::sort(messages.begin(), messages.end(), [](const TimedMessage& a, const TimedMessage& b) {
+    return a.tick != b.tick ? a.tick < b.tick : a.order < b.order;
+  });
   // Ticks to nanoseconds, exactly: each tempo segment from its own start (no accumulated rounding).
   const auto toNanos = [&](std::uint64_t tick) -> std::int64_t {
     if ((division & 0x8000) != 0) {

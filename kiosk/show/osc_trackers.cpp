@@ -151,6 +151,7 @@ DeviceSource OscTrackerFeeds::sourceFor(const DeviceSpec& spec) const {
 
 std::unique_ptr<devices::DeviceProvider> OscTrackerFeeds::provider() const {
   std::vector<std::shared_ptr<Feed>> feeds;
+  feeds.reserve(feeds_.size());
   for (const auto& [name, feed] : feeds_) feeds.push_back(feed);
   return std::make_unique<OscTrackerProvider>(std::move(feeds));
 }
