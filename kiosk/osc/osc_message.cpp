@@ -51,14 +51,37 @@ void parseMessage(std::span<const std::byte> bytes, OscPacket& out) {
   for (int i = 0; i < argc && types[i] != '\0'; ++i) {
     OscArgument a;
     a.type = types[i];
-    const lo_arg& v = *argv[i];
+    // liblo's argument pointers point into the message's data, which OSC aligns to 4 bytes only:
+    // a 64-bit value may sit at an address an lo_arg (8-byte aligned) cannot. Each value is
+    // copied out by its own size instead of read through the union.
+    const auto* raw = reinterpret_cast<const char*>(argv[i]);
     switch (a.type) {
-      case LO_INT32: a.number = v.i; break;
-      case LO_INT64: a.number = static_cast<double>(v.h); break;
-      case LO_FLOAT: a.number = static_cast<double>(v.f); break;
-      case LO_DOUBLE: a.number = v.d; break;
+      case LO_INT32: {
+        std::int32_t v = 0;
+        std::memcpy(&v, raw, sizeof v);
+        a.number = v;
+        break;
+      }
+      case LO_INT64: {
+        std::int64_t v = 0;
+        std::memcpy(&v, raw, sizeof v);
+        a.number = static_cast<double>(v);
+        break;
+      }
+      case LO_FLOAT: {
+        float v = 0;
+        std::memcpy(&v, raw, sizeof v);
+        a.number = static_cast<double>(v);
+        break;
+      }
+      case LO_DOUBLE: {
+        double v = 0;
+        std::memcpy(&v, raw, sizeof v);
+        a.number = v;
+        break;
+      }
       case LO_STRING:
-      case LO_SYMBOL: a.text = &v.s; break;
+      case LO_SYMBOL: a.text = raw; break;
       default: break;  // kept as its type: no binding takes it
     }
     m.arguments.push_back(std::move(a));
