@@ -1280,38 +1280,21 @@ class Reader {
   }
 
   void readFrom(const toml::node& node, const std::string& path, ViewSpec& v) {
-    const toml::array* a = node.as_array();
-    std::array<float, 3> values{};
-    bool ok = a && a->size() == 3;
-    for (std::size_t i = 0; ok && i < 3; ++i) {
-      const toml::node* element = a->get(i);
-      const auto n = element ? element->value<double>() : std::nullopt;
-      ok = n && std::isfinite(*n) && std::abs(*n) <= 1e6;
-      if (ok) values[i] = static_cast<float>(*n);
-    }
-    ok = ok && (values[0] != 0 || values[1] != 0 || values[2] != 0);
-    if (!ok) {
+    const auto values = point(node);
+    if (!values || ((*values)[0] == 0 && (*values)[1] == 0 && (*values)[2] == 0)) {
       error(lineOf(node), fmt::format("{}.from: must be a direction [x, y, z] in the cave's axes, not all zero", path));
       return;
     }
-    v.from = values;
+    v.from = *values;
   }
 
   void readDisplayAt(const toml::node& node, const std::string& path, ViewSpec& v) {
-    const toml::array* a = node.as_array();
-    std::array<float, 3> values{};
-    bool ok = a && a->size() == 3;
-    for (std::size_t i = 0; ok && i < 3; ++i) {
-      const toml::node* element = a->get(i);
-      const auto n = element ? element->value<double>() : std::nullopt;
-      ok = n && std::isfinite(*n) && std::abs(*n) <= 1e6;
-      if (ok) values[i] = static_cast<float>(*n);
-    }
-    if (!ok) {
+    const auto values = point(node);
+    if (!values) {
       error(lineOf(node), fmt::format("{}.display_at: must be a position [x, y, z] in scene units", path));
       return;
     }
-    v.displayAt = values;
+    v.displayAt = *values;
   }
 
   void readViewport(const toml::node& node, const std::string& path, ViewSpec& v) {
