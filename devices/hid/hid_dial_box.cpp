@@ -68,6 +68,20 @@ std::string busOf(hid_bus_type bus) {
   }
 }
 
+/// Opens the hidraw node of a dial box or tracker, saying why it cannot (permissions: the udev rule).
+Result<HidDevicePtr> openHidraw(const DeviceInfo& info) {
+  if (!hidInit()) return fail(Errc::kUnavailable, "hidapi could not start", info.path);
+  HidDevicePtr dev(hid_open_path(info.path.c_str()));
+  if (!dev) {
+    const int e = errno;
+    if (e == EACCES || e == EPERM) {
+      return fail(Errc::kPermissionDenied, fmt::format("permission denied; {}", kUdevRuleHint), info.path);
+    }
+    return fail(Errc::kUnavailable, fmt::format("cannot open: {}", hidError(nullptr)), info.path);
+  }
+  return dev;
+}
+
 class HidrawDialBox final : public DecodingDialBox {
  public:
   HidrawDialBox(DeviceInfo info, std::vector<std::uint8_t> descriptor, DialDecoder decoder, const Clock& clock)
@@ -78,16 +92,9 @@ class HidrawDialBox final : public DecodingDialBox {
 
  private:
   Result<void> doOpen() override {
-    if (!hidInit()) return fail(Errc::kUnavailable, "hidapi could not start", info().path);
-    HidDevicePtr dev(hid_open_path(info().path.c_str()));
-    if (!dev) {
-      const int e = errno;
-      if (e == EACCES || e == EPERM) {
-        return fail(Errc::kPermissionDenied, fmt::format("permission denied; {}", kUdevRuleHint), info().path);
-      }
-      return fail(Errc::kUnavailable, fmt::format("cannot open: {}", hidError(nullptr)), info().path);
-    }
-    device_ = std::move(dev);
+    auto dev = openHidraw(info());
+    if (!dev) return std::unexpected(dev.error());
+    device_ = std::move(*dev);
     startReader();
     return {};
   }
@@ -123,16 +130,9 @@ class HidrawTracker final : public Tracker {
 
  private:
   Result<void> doOpen() override {
-    if (!hidInit()) return fail(Errc::kUnavailable, "hidapi could not start", info().path);
-    HidDevicePtr dev(hid_open_path(info().path.c_str()));
-    if (!dev) {
-      const int e = errno;
-      if (e == EACCES || e == EPERM) {
-        return fail(Errc::kPermissionDenied, fmt::format("permission denied; {}", kUdevRuleHint), info().path);
-      }
-      return fail(Errc::kUnavailable, fmt::format("cannot open: {}", hidError(nullptr)), info().path);
-    }
-    device_ = std::move(dev);
+    auto dev = openHidraw(info());
+    if (!dev) return std::unexpected(dev.error());
+    device_ = std::move(*dev);
     stop_.store(false);
     reader_ = std::thread([this] { readLoop(); });
     return {};
